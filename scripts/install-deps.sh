@@ -1,0 +1,39 @@
+#!/usr/bin/env bash
+# Installs every system package DynaVINS needs on Debian 12. The one place the dependency list lives.
+# Idempotent: only asks apt for what is missing, so `make demo` / `make test` stay fast on a set-up machine.
+set -euo pipefail
+
+PACKAGES=(
+  # build tools
+  build-essential cmake ninja-build ccache pkg-config
+  # maths, vision, optimisation
+  libeigen3-dev libceres-dev libopencv-dev
+  # lock-free bounded queues (moodycamel)
+  libconcurrentqueue-dev libreaderwriterqueue-dev
+  # logging, command line, tests
+  libspdlog-dev libcli11-dev catch2
+  # LCM: C/C++ library, lcm-gen/lcm-logger/lcm-spy, Java bindings for lcm-spy, a JDK for the types jar
+  liblcm-dev liblcm-bin liblcm-java default-jdk-headless
+  # gzip-compressed trajectory files
+  zlib1g-dev
+  # network namespace tools for udpm tests (unshare, ip)
+  util-linux iproute2
+)
+
+missing=()
+for p in "${PACKAGES[@]}"; do
+  if ! dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed"; then
+    missing+=("$p")
+  fi
+done
+
+if [ ${#missing[@]} -eq 0 ]; then
+  exit 0
+fi
+
+echo "install-deps: installing ${missing[*]}"
+SUDO=""
+if [ "$(id -u)" -ne 0 ]; then SUDO="sudo"; fi
+export DEBIAN_FRONTEND=noninteractive
+$SUDO apt-get update -qq
+$SUDO apt-get install -y -qq --no-install-recommends "${missing[@]}"
