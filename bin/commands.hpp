@@ -21,5 +21,7 @@ void add_info_command(CLI::App& app);
 void add_log_info_command(CLI::App& app);
 void add_pipeline_check_command(CLI::App& app);
 void add_eval_command(CLI::App& app);
+void add_convert_command(CLI::App& app);
+void add_replay_command(CLI::App& app);
 
 }  // namespace dynavins::cli

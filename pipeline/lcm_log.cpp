@@ -65,9 +65,9 @@ LcmLogReader::~LcmLogReader() {
   if (fp_) std::fclose(fp_);
 }
 
-std::string LcmLogReader::where(const LogRecord& r) const {
-  return path_ + ": event #" + std::to_string(r.eventnum) + " (byte " + std::to_string(r.offset) +
-         ", channel " + r.channel + ")";
+std::string LcmLogReader::event_name(const LogRecord& r) {
+  return "event #" + std::to_string(r.eventnum) + " (byte " + std::to_string(r.offset) + ", channel " + r.channel +
+         ")";
 }
 
 bool LcmLogReader::next(LogRecord& out) {

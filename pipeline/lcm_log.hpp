@@ -76,8 +76,10 @@ class LcmLogReader {
     return m;
   }
 
-  /// "file: event #N (byte B, channel C)" for error messages.
-  std::string where(const LogRecord& r) const;
+  /// "event #N (byte B, channel C)" for error messages.
+  static std::string event_name(const LogRecord& r);
+  /// "file: event #N (byte B, channel C)".
+  std::string where(const LogRecord& r) const { return path_ + ": " + event_name(r); }
   const std::string& path() const { return path_; }
   int64_t file_size() const { return size_; }
   int64_t position() const { return pos_; }

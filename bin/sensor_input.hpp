@@ -1,0 +1,27 @@
+#pragma once
+// The recorded-input options shared by `convert`, `replay` and later `run`:
+// exactly one of --euroc DIR, --log FILE.lcmlog (and --rosbag FILE.bag once it is built in).
+
+#include <memory>
+#include <string>
+
+#include "io/sensor_source.hpp"
+
+namespace CLI {
+class App;
+}
+
+namespace dynavins::cli {
+
+struct SensorInput {
+  std::string euroc;
+  std::string log;
+  std::string rosbag;
+
+  /// Adds the options to `cmd`, mutually exclusive, one required.
+  void add_options(CLI::App& cmd, bool with_log);
+  /// Opens the chosen input; throws CommandError (exit 2) on bad input.
+  std::unique_ptr<io::SensorSource> open() const;
+};
+
+}  // namespace dynavins::cli
