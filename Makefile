@@ -38,7 +38,7 @@ test-tsan: deps
 	cmake -S . -B $(TSAN_BUILD) $(CMAKE_GEN) -DCMAKE_BUILD_TYPE=RelWithDebInfo -DDYNAVINS_TSAN=ON
 	cmake --build $(TSAN_BUILD)
 	TSAN_OPTIONS="halt_on_error=1 second_deadlock_stack=1 suppressions=$(CURDIR)/tests/tsan.supp" \
-	  ctest --test-dir $(TSAN_BUILD) --output-on-failure -j $(CTEST_J)
+	  ctest --test-dir $(TSAN_BUILD) --output-on-failure -j $(CTEST_J) -LE heavy
 
 clean:
 	rm -rf $(BUILD) $(TSAN_BUILD)

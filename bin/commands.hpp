@@ -23,5 +23,6 @@ void add_pipeline_check_command(CLI::App& app);
 void add_eval_command(CLI::App& app);
 void add_convert_command(CLI::App& app);
 void add_replay_command(CLI::App& app);
+void add_sim_command(CLI::App& app);
 
 }  // namespace dynavins::cli

@@ -24,6 +24,7 @@ int main(int argc, char** argv) {
   dynavins::cli::add_info_command(app);
   dynavins::cli::add_log_info_command(app);
   dynavins::cli::add_pipeline_check_command(app);
+  dynavins::cli::add_sim_command(app);
   dynavins::cli::add_convert_command(app);
   dynavins::cli::add_replay_command(app);
   dynavins::cli::add_eval_command(app);

@@ -1,0 +1,60 @@
+#include <filesystem>
+#include <fstream>
+
+#include <catch2/catch.hpp>
+
+#include "sim/scenario/scenario_spec.hpp"
+
+using namespace dynavins::sim;
+namespace fs = std::filesystem;
+
+namespace {
+std::string write_yaml(const std::string& name, const std::string& body) {
+  const fs::path dir = fs::temp_directory_path() / "dynavins_test_scenario";
+  fs::create_directories(dir);
+  std::ofstream(dir / name) << "%YAML:1.0\n---\n" << body;
+  return (dir / name).string();
+}
+}  // namespace
+
+TEST_CASE("load_scenario reads every part of a scenario", "[scenario]") {
+  const auto path = write_yaml("ok.yaml",
+                               "name: t\nseed: 3\nduration: 12.5\nphotometric: night\n"
+                               "world: { x_min: -10, x_max: 90, seed: 5 }\n"
+                               "motion: { profile: car, cruise_speed: 4, waypoints: [0, 0, 1.5, 50, 0, 1.5] }\n"
+                               "objects:\n"
+                               "  - { kind: truck, motion: lane, x0: 30, y: -1.75, speed: 3 }\n"
+                               "  - { kind: car, motion: cross_ahead, t: 5, distance: 6, speed: -4 }\n"
+                               "  - { kind: truck, motion: follow, distance: 7 }\n"
+                               "  - { kind: board, motion: relocate, poses: [0, 10, 4, 90, 20, 40, 4, 90] }\n");
+  const ScenarioSpec s = load_scenario(path);
+  CHECK(s.name == "t");
+  CHECK(s.seed == 3);
+  CHECK(s.duration == 12.5);
+  CHECK(s.photometric == "night");
+  CHECK(s.world_x_max == 90);
+  CHECK(s.profile == "car");
+  REQUIRE(s.waypoints.size() == 2);
+  CHECK(s.waypoints[1] == Eigen::Vector3d(50, 0, 1.5));
+  REQUIRE(s.objects.size() == 4);
+  CHECK(s.objects[0].motion == ObjectMotion::Lane);
+  CHECK(s.objects[1].speed == -4);
+  CHECK(s.objects[2].motion == ObjectMotion::Follow);
+  REQUIRE(s.objects[3].poses.size() == 2);
+  CHECK(s.objects[3].poses[1][1] == 40);
+}
+
+TEST_CASE("load_scenario: a wrong, unknown or missing key is an error naming key and file", "[scenario]") {
+  const std::string motion = "motion: { waypoints: [0, 0, 1.5, 50, 0, 1.5] }\n";
+  auto p = write_yaml("typo.yaml", "name: t\nsede: 3\n" + motion);
+  CHECK_THROWS_WITH(load_scenario(p), Catch::Contains(p) && Catch::Contains("sede: unknown key"));
+  p = write_yaml("nomotion.yaml", "name: t\n");
+  CHECK_THROWS_WITH(load_scenario(p), Catch::Contains("motion: missing"));
+  p = write_yaml("kind.yaml", "name: t\n" + motion + "objects:\n  - { kind: bus, motion: lane, x0: 0, y: 0, speed: 1 }\n");
+  CHECK_THROWS_WITH(load_scenario(p), Catch::Contains("kind: 'bus' is not one of"));
+  p = write_yaml("lane.yaml", "name: t\n" + motion + "objects:\n  - { kind: car, motion: lane, x0: 0, y: 0 }\n");
+  CHECK_THROWS_WITH(load_scenario(p), Catch::Contains("speed: missing"));
+  p = write_yaml("wp.yaml", "name: t\nmotion: { waypoints: [0, 0, 1.5, 50, 0] }\n");
+  CHECK_THROWS_WITH(load_scenario(p), Catch::Contains("groups of 3"));
+  CHECK_THROWS_WITH(load_scenario("/nonexistent/s.yaml"), Catch::Contains("/nonexistent/s.yaml"));
+}
