@@ -1,7 +1,8 @@
 // `dynavins sim --scenario NAME|FILE.yaml --out DIR`: renders a synthetic dynamic scene into
 //   DIR/sensors.lcmlog        stereo images (+ per-pixel moving-object labels), 200 Hz IMU, ground truth
 //   DIR/groundtruth.tum       body poses at IMU rate (for `dynavins eval`)
-//   DIR/preview.png           the stereo frame with the most moving pixels, labels tinted red
+//   DIR/preview.png           a stereo frame showing both street and traffic (moving share nearest 60%)
+//   DIR/preview_labels.png    the same frame with its moving-object pixels tinted red
 //   with --euroc, DIR/euroc/  an EuRoC ASL folder plus vins_config.yaml and camodocs camera files
 // Outputs are written under a .partial name and renamed when complete.
 #include <filesystem>
@@ -52,16 +53,16 @@ io::VinsStereoConfig vins_config(const sim::Scenario& s) {
   return c;
 }
 
-cv::Mat preview(const StereoFrame& f) {
-  cv::Mat left, right, both;
+/// Left | right, and left | left with moving-object pixels tinted red.
+std::pair<cv::Mat, cv::Mat> previews(const StereoFrame& f) {
+  cv::Mat raw, left, tinted, labelled;
+  cv::hconcat(f.left, f.right, raw);
   cv::cvtColor(f.left, left, cv::COLOR_GRAY2BGR);
-  cv::cvtColor(f.right, right, cv::COLOR_GRAY2BGR);
-  cv::Mat tint(left.size(), left.type(), cv::Scalar(40, 40, 255));
-  cv::Mat blended;
-  cv::addWeighted(left, 0.6, tint, 0.4, 0, blended);
-  blended.copyTo(left, f.labels > 0);
-  cv::hconcat(left, right, both);
-  return both;
+  cv::addWeighted(left, 0.6, cv::Mat(left.size(), left.type(), cv::Scalar(40, 40, 255)), 0.4, 0, tinted);
+  cv::Mat marked = left.clone();
+  tinted.copyTo(marked, f.labels > 0);
+  cv::hconcat(left, marked, labelled);
+  return {raw, labelled};
 }
 
 void run_sim(const SimOptions& o) {
@@ -84,9 +85,9 @@ void run_sim(const SimOptions& o) {
   if (o.euroc) euroc = std::make_unique<io::EurocWriter>(euroc_dir + ".partial");
   eval::Trajectory truth;
   pipeline::Progress progress("sim");
-  double moving_sum = 0, moving_max = -1;
+  double moving_sum = 0, moving_max = 0, preview_gap = 2.0;
   int64_t frames = 0;
-  cv::Mat best_preview;
+  std::pair<cv::Mat, cv::Mat> best_preview;
   SensorEvent e;
   while (source.next(e)) {
     pipeline::write_sensor_event(log, e, o.raw ? pipeline::ImageEncoding::Gray8 : pipeline::ImageEncoding::Png);
@@ -96,7 +97,8 @@ void run_sim(const SimOptions& o) {
     } else if (const auto* f = std::get_if<StereoFrame>(&e)) {
       const double moving = static_cast<double>(cv::countNonZero(f->labels)) / static_cast<double>(f->labels.total());
       moving_sum += moving;
-      if (moving > moving_max) moving_max = moving, best_preview = preview(*f);
+      moving_max = std::max(moving_max, moving);
+      if (std::abs(moving - 0.6) < preview_gap) preview_gap = std::abs(moving - 0.6), best_preview = previews(*f);
       ++frames;
       progress.update(source.progress(), fmt::format("{}/{} frames", frames, source.frame_count()));
     }
@@ -104,7 +106,8 @@ void run_sim(const SimOptions& o) {
   log.close();
   fs::rename(log_path + ".partial", log_path);
   eval::write_tum(o.out + "/groundtruth.tum", truth);
-  cv::imwrite(o.out + "/preview.png", best_preview);
+  cv::imwrite(o.out + "/preview.png", best_preview.first);
+  cv::imwrite(o.out + "/preview_labels.png", best_preview.second);
   if (euroc) {
     euroc->close();
     io::write_vins_stereo_config(euroc_dir + ".partial", vins_config(*scenario));
@@ -114,7 +117,7 @@ void run_sim(const SimOptions& o) {
   progress.done(fmt::format("{} stereo frames, moving pixels {:.1f}% on average, {:.1f}% at most", frames,
                             100.0 * moving_sum / static_cast<double>(std::max<int64_t>(frames, 1)),
                             100.0 * moving_max));
-  spdlog::info("wrote {}, {}/groundtruth.tum, {}/preview.png{}", log_path, o.out, o.out,
+  spdlog::info("wrote {}, {}/groundtruth.tum, {}/preview(_labels).png{}", log_path, o.out, o.out,
                o.euroc ? ", " + euroc_dir + "/ (EuRoC + vins_config.yaml)" : std::string());
 }
 

@@ -6,6 +6,7 @@
 
 #include <opencv2/core.hpp>
 
+#include "sim/render/parallel_rows.hpp"
 #include "sim/render/random.hpp"
 #include "sim/render/texture_canvas.hpp"
 
@@ -169,7 +170,7 @@ cv::Mat paint_ground(const GroundLayout& g, double x0, double y0, double w, doub
   cv::Mat1f marking(rows, cols, 0.0f);
   cv::Mat1f& img = c.image();
 
-  cv::parallel_for_(cv::Range(0, rows), [&](const cv::Range& range) {
+  parallel_rows(rows, [&](const cv::Range& range) {
     for (int r = range.start; r < range.end; ++r) {
       for (int col = 0; col < cols; ++col) {
         const V2 p = c.centre(col, r);

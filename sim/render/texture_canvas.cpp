@@ -1,5 +1,7 @@
 #include "sim/render/texture_canvas.hpp"
 
+#include "sim/render/parallel_rows.hpp"
+
 #include <algorithm>
 #include <cmath>
 
@@ -175,7 +177,7 @@ cv::Mat1f TextureCanvas::noise_field(uint64_t key, double cell_m) const {
   const float fdac = static_cast<float>(dac), fdar = static_cast<float>(dar);
   const float fdbc = static_cast<float>(dbc), fdbr = static_cast<float>(dbr);
   cv::Mat1f out(img_.rows, img_.cols);
-  cv::parallel_for_(cv::Range(0, img_.rows), [&](const cv::Range& range) {
+  parallel_rows(img_.rows, [&](const cv::Range& range) {
     for (int r = range.start; r < range.end; ++r) {
       float* o = out.ptr<float>(r);
       const float ar = la0 + fdar * static_cast<float>(r);
@@ -258,7 +260,7 @@ void TextureCanvas::scale_blotches(uint64_t key, double cell_m, float threshold,
 void TextureCanvas::add_grain(uint64_t key, float amplitude) {
   const int64_t gc0 = static_cast<int64_t>(std::llround(x0_ / texel_));
   const int64_t gr0 = static_cast<int64_t>(std::llround(y0_ / texel_));
-  cv::parallel_for_(cv::Range(0, img_.rows), [&](const cv::Range& range) {
+  parallel_rows(img_.rows, [&](const cv::Range& range) {
     for (int r = range.start; r < range.end; ++r) {
       float* p = img_.ptr<float>(r);
       const uint64_t row_key = hash3(key, gr0 + r, 0x9e37);
