@@ -1,0 +1,143 @@
+#include "stages/common/config_reader.hpp"
+
+#include <cmath>
+#include <filesystem>
+
+#include <opencv2/core.hpp>
+
+namespace dynavins {
+namespace {
+
+std::string type_name(const cv::FileNode& n) {
+  if (n.isInt()) return "an integer";
+  if (n.isReal()) return "a real number";
+  if (n.isString()) return "the string \"" + n.string() + "\"";
+  if (n.isMap()) return "a map";
+  if (n.isSeq()) return "a sequence";
+  return "an empty value";
+}
+
+// OpenCV keeps "true # comment" as the whole scalar; keep the first word only.
+std::string first_word(const std::string& s) {
+  const auto b = s.find_first_not_of(" \t");
+  if (b == std::string::npos) return {};
+  const auto e = s.find_first_of(" \t#", b);
+  return s.substr(b, e == std::string::npos ? std::string::npos : e - b);
+}
+
+}  // namespace
+
+ConfigReader::ConfigReader(const std::string& path) : path_(path) {
+  if (!std::filesystem::is_regular_file(path)) throw ConfigError(path, "", "file not found");
+  try {
+    fs_.open(path, cv::FileStorage::READ);
+  } catch (const cv::Exception& e) {
+    throw ConfigError(path, "", "not a valid OpenCV yaml file: " + e.msg);
+  }
+  if (!fs_.isOpened()) throw ConfigError(path, "", "cannot open as an OpenCV yaml file");
+}
+
+void ConfigReader::fail(const std::string& key, const std::string& problem) const {
+  throw ConfigError(path_, key, problem);
+}
+
+cv::FileNode ConfigReader::node(const std::string& key) const { return fs_[key]; }
+
+bool ConfigReader::has(const std::string& key) const {
+  const cv::FileNode n = node(key);
+  return !n.empty() && !n.isNone();
+}
+
+std::optional<int> ConfigReader::find_int(const std::string& key) const {
+  if (!has(key)) return std::nullopt;
+  const cv::FileNode n = node(key);
+  if (n.isInt()) return static_cast<int>(n);
+  if (n.isReal()) {
+    const double v = static_cast<double>(n);
+    if (v == std::round(v) && std::abs(v) < 2e9) return static_cast<int>(v);
+  }
+  fail(key, "expected an integer, found " + type_name(n));
+}
+
+std::optional<double> ConfigReader::find_double(const std::string& key) const {
+  if (!has(key)) return std::nullopt;
+  const cv::FileNode n = node(key);
+  if (n.isInt() || n.isReal()) return static_cast<double>(n);
+  fail(key, "expected a number, found " + type_name(n));
+}
+
+std::optional<bool> ConfigReader::find_bool(const std::string& key) const {
+  if (!has(key)) return std::nullopt;
+  const cv::FileNode n = node(key);
+  if (n.isInt()) {
+    const int v = static_cast<int>(n);
+    if (v == 0 || v == 1) return v == 1;
+  } else if (n.isString()) {
+    const std::string w = first_word(n.string());
+    if (w == "true" || w == "True" || w == "TRUE") return true;
+    if (w == "false" || w == "False" || w == "FALSE") return false;
+  }
+  fail(key, "expected 0/1 or true/false, found " + type_name(n));
+}
+
+int ConfigReader::get_int(const std::string& key) const {
+  if (auto v = find_int(key)) return *v;
+  fail(key, "required key is missing");
+}
+
+double ConfigReader::get_double(const std::string& key) const {
+  if (auto v = find_double(key)) return *v;
+  fail(key, "required key is missing");
+}
+
+bool ConfigReader::get_bool(const std::string& key) const {
+  if (auto v = find_bool(key)) return *v;
+  fail(key, "required key is missing");
+}
+
+std::string ConfigReader::get_string(const std::string& key) const {
+  if (!has(key)) fail(key, "required key is missing");
+  const cv::FileNode n = node(key);
+  if (!n.isString()) fail(key, "expected a string, found " + type_name(n));
+  return n.string();
+}
+
+double ConfigReader::get_nested_double(const std::string& map, const std::string& key) const {
+  const std::string full = map + "." + key;
+  const cv::FileNode m = node(map);
+  if (m.empty() || m.isNone()) fail(full, "required key is missing (no '" + map + "' section)");
+  if (!m.isMap()) fail(map, "expected a map, found " + type_name(m));
+  const cv::FileNode n = m[key];
+  if (n.empty() || n.isNone()) fail(full, "required key is missing");
+  if (!n.isInt() && !n.isReal()) fail(full, "expected a number, found " + type_name(n));
+  return static_cast<double>(n);
+}
+
+Eigen::Isometry3d ConfigReader::get_transform(const std::string& key) const {
+  if (!has(key)) fail(key, "required key is missing");
+  const cv::FileNode n = node(key);
+  if (!n.isMap()) fail(key, "expected a 4x4 !!opencv-matrix, found " + type_name(n));
+  cv::Mat m;
+  try {
+    n >> m;
+  } catch (const cv::Exception& e) {
+    fail(key, "not a valid !!opencv-matrix: " + e.msg);
+  }
+  if (m.rows != 4 || m.cols != 4 || m.channels() != 1)
+    fail(key, "expected a 4x4 matrix, found " + std::to_string(m.rows) + "x" + std::to_string(m.cols));
+  m.convertTo(m, CV_64F);
+  Eigen::Matrix4d T;
+  for (int r = 0; r < 4; ++r)
+    for (int c = 0; c < 4; ++c) T(r, c) = m.at<double>(r, c);
+  if (!T.allFinite()) fail(key, "matrix has non-finite entries");
+  if ((T.row(3) - Eigen::RowVector4d(0, 0, 0, 1)).norm() > 1e-9) fail(key, "last row must be [0, 0, 0, 1]");
+  const Eigen::Matrix3d R = T.topLeftCorner<3, 3>();
+  if ((R.transpose() * R - Eigen::Matrix3d::Identity()).norm() > 1e-3 || R.determinant() < 0)
+    fail(key, "top-left 3x3 block is not a rotation");
+  Eigen::Isometry3d out = Eigen::Isometry3d::Identity();
+  out.linear() = Eigen::Quaterniond(R).normalized().toRotationMatrix();
+  out.translation() = T.topRightCorner<3, 1>();
+  return out;
+}
+
+}  // namespace dynavins

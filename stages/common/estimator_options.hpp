@@ -1,0 +1,73 @@
+#pragma once
+// Every option of the front end and estimator, loaded from a VINS-Fusion or DynaVINS yaml as the
+// user wrote it (OpenVINS style: a struct that loads and prints itself).
+//
+// DynaVINS keys, read with the authors' code's meaning (url-kaist/dynaVINS, config/viode):
+//   regularization_lambda = gamma: their regularization residual is gamma*(1-w), so the paper's
+//                           lambda_w = gamma^2 (stored in lambda_w; the paper's default 1.0 when absent).
+//   momentum_lambda       = lambda_m of the momentum term (paper III-D), used as given; default 0.2.
+//   alternating_converge  = fraction of feature weights that must have settled before the
+//                           alternating (weights <-> states) optimization stops; default 0.9.
+//   margin_feature_thresh = features whose weight is below it are left out of marginalization; 0.1.
+//   dyna_on / momentum_on = switches (true/false or 0/1); both default true.
+// max_solver_time is in seconds (Ceres' budget), whatever VINS-Fusion's comment says.
+
+#include <set>
+#include <string>
+#include <vector>
+
+#include <Eigen/Geometry>
+
+#include "stages/common/camera_model.hpp"
+
+namespace dynavins {
+
+struct EstimatorOptions {
+  std::string config_file;
+
+  // Sensors.
+  bool use_imu = true;                    ///< key imu
+  int num_of_cam = 1;                     ///< 1 (mono) or 2 (stereo)
+  std::vector<std::string> camera_files;  ///< resolved cam0_calib / cam1_calib paths
+  std::vector<CameraModelPtr> cameras;
+  std::vector<Eigen::Isometry3d> body_T_cam;  ///< camera -> body (IMU) frame, one per camera
+  int image_width = 0, image_height = 0;
+  int estimate_extrinsic = 0;  ///< 0 fixed, 1 refine around body_T_cam, 2 calibrate from scratch
+
+  // Feature tracker (VINS-Fusion's defaults when absent).
+  int max_cnt = 150;
+  double min_dist = 30;  ///< pixels
+  double freq = 10;      ///< Hz of published tracking; 0 = every image
+  double F_threshold = 1.0;
+  bool show_track = false;
+  bool flow_back = true;
+
+  // Optimization.
+  double max_solver_time = 0.04;  ///< seconds
+  int max_num_iterations = 8;
+  double keyframe_parallax = 10.0;  ///< pixels
+  int window_size = 10;             ///< sliding window (fixed at compile time in VINS-Fusion)
+
+  // IMU noise (continuous-time standard deviations); required when imu is 1.
+  double acc_n = 0.1, gyr_n = 0.01, acc_w = 0.001, gyr_w = 0.0001, g_norm = 9.81;
+  bool estimate_td = false;
+  double td = 0.0;  ///< seconds; image clock + td = IMU clock
+
+  // DynaVINS (see the mapping above).
+  bool dyna_on = true;
+  double regularization_gamma = 1.0;  ///< key regularization_lambda as written
+  double lambda_w = 1.0;              ///< = regularization_gamma^2, the paper's lambda_w
+  bool momentum_on = true;
+  double lambda_m = 0.2;  ///< key momentum_lambda
+  double alternating_converge = 0.9;
+  double margin_feature_thresh = 0.1;
+
+  std::set<std::string> keys_from_file;  ///< which options the file set (the rest are defaults)
+
+  /// Loads `path`; throws ConfigError naming key and file on missing or wrongly typed keys.
+  static EstimatorOptions load(const std::string& path);
+  /// Every effective option, one per line, with "(file)" or "(default)".
+  std::string print() const;
+};
+
+}  // namespace dynavins
