@@ -80,15 +80,6 @@ RefHit reference(const World& w, double t, const Eigen::Isometry3d& T_wc, const 
   return best;
 }
 
-const World& street() {
-  static const World w = [] {
-    StreetSceneOptions o;
-    o.truck_start_x = 5.0;
-    return make_street_scene(o);
-  }();
-  return w;
-}
-
 }  // namespace
 
 TEST_CASE("Renderer: depth and labels match independent ray casting", "[render]") {
@@ -302,38 +293,4 @@ TEST_CASE("Renderer: output is deterministic and render_stereo equals two render
   const RenderedView r2 = renderer.render(w, 0.7, T_wl * T_lr);
   CHECK(cv::norm(r.gray, r2.gray, cv::NORM_INF) == 0.0);
   CHECK(cv::norm(r.labels, r2.labels, cv::NORM_INF) == 0.0);
-}
-
-TEST_CASE("Renderer: time per view on the example street (printed, not asserted)", "[render][timing]") {
-  // Thread CPU time next to wall time: the machine is shared, CPU time is the steadier figure.
-  auto cpu_ms = [] {
-    timespec ts;
-    clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts);
-    return ts.tv_sec * 1e3 + ts.tv_nsec * 1e-6;
-  };
-  const World& w = street();
-  const Renderer renderer;
-  std::printf("street scene: %zu quads, %.1f MB of textures\n", w.num_quads(), w.texture_bytes() / 1e6);
-  const int n = 20;
-  double wall = 0.0, cpu = 0.0, worst = 0.0;
-  for (int k = 0; k < n; ++k) {
-    const double t = 0.05 * k;
-    const auto t0 = std::chrono::steady_clock::now();
-    const double c0 = cpu_ms();
-    const RenderedView v = renderer.render(w, t, street_camera_pose(3.0 * t, -1.75, 1.5, 0.02 * std::sin(t)));
-    cpu += cpu_ms() - c0;
-    const double ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
-    wall += ms;
-    worst = std::max(worst, ms);
-    REQUIRE(!v.gray.empty());
-  }
-  std::printf("render 752x480 street view: %.1f ms CPU, %.1f ms wall (worst %.1f), one thread\n", cpu / n,
-              wall / n, worst);
-  Eigen::Isometry3d T_lr = Eigen::Isometry3d::Identity();
-  T_lr.translation().x() = 0.11;
-  const auto t0 = std::chrono::steady_clock::now();
-  for (int k = 0; k < n; ++k) renderer.render_stereo(w, 0.05 * k, street_camera_pose(0.15 * k, -1.75, 1.5), T_lr);
-  const double ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count() / n;
-  std::printf("render_stereo: %.1f ms wall per stereo pair (two threads)\n", ms);
-  SUCCEED();
 }
