@@ -7,28 +7,13 @@
 
 #include "sim/motion/imu_simulator.hpp"
 #include "sim/motion/so3.hpp"
-#include "sim/motion/waypoint_path.hpp"
+#include "tests/imu/wavy_trajectory.hpp"
 #include "stages/imu/imu_interval_builder.hpp"
 
 using namespace dynavins;
 using namespace dynavins::sim;
 
 namespace {
-
-SmoothTrajectory wavyTrajectory() {
-  std::vector<Waypoint> w;
-  for (int k = 0; k <= 12; ++k) {
-    const double t = 0.5 * k;
-    Waypoint p;
-    p.t = t;
-    p.p = Eigen::Vector3d(2.0 * std::sin(0.6 * t), 1.5 * std::cos(0.5 * t), 0.4 * std::sin(0.9 * t));
-    p.yaw = 0.8 * std::sin(0.7 * t);
-    p.pitch = 0.3 * std::sin(1.1 * t);
-    p.roll = 0.25 * std::cos(0.9 * t);
-    w.push_back(p);
-  }
-  return trajectoryFromTimedWaypoints(w);
-}
 
 std::vector<ImuSample> imu(const SmoothTrajectory& tr, int64_t t0, int64_t t1) {
   ImuSimulatorOptions o;
@@ -58,7 +43,7 @@ double maxDeltaError(const SmoothTrajectory& tr, const PreintegratedInterval& iv
 
 TEST_CASE("one interval per consecutive frame pair, ends at the frame times, matching ground truth",
           "[imu][interval_builder]") {
-  const SmoothTrajectory tr = wavyTrajectory();
+  const SmoothTrajectory tr = wavyTrajectory(6.0);
   const std::vector<ImuSample> s = imu(tr, 1'900'000'000, 2'600'000'000);
   const std::vector<int64_t> f = frameTimes();
   ImuIntervalBuilder b;
@@ -86,7 +71,7 @@ TEST_CASE("one interval per consecutive frame pair, ends at the frame times, mat
 }
 
 TEST_CASE("the interleaving of IMU and frames does not change the intervals", "[imu][interval_builder]") {
-  const SmoothTrajectory tr = wavyTrajectory();
+  const SmoothTrajectory tr = wavyTrajectory(6.0);
   const std::vector<ImuSample> s = imu(tr, 1'900'000'000, 2'600'000'000);
   const std::vector<int64_t> f = frameTimes();
   // Reference: all IMU first, then the frames.
@@ -113,7 +98,7 @@ TEST_CASE("the interleaving of IMU and frames does not change the intervals", "[
 }
 
 TEST_CASE("out-of-order and duplicate IMU samples are rejected and counted", "[imu][interval_builder]") {
-  const SmoothTrajectory tr = wavyTrajectory();
+  const SmoothTrajectory tr = wavyTrajectory(6.0);
   const std::vector<ImuSample> s = imu(tr, 1'900'000'000, 2'600'000'000);
   const std::vector<int64_t> f = frameTimes();
   ImuIntervalBuilder clean, dirty;
@@ -144,7 +129,7 @@ TEST_CASE("out-of-order and duplicate IMU samples are rejected and counted", "[i
 
 TEST_CASE("an IMU gap above 3 periods is reported in its interval, not bridged silently",
           "[imu][interval_builder]") {
-  const SmoothTrajectory tr = wavyTrajectory();
+  const SmoothTrajectory tr = wavyTrajectory(6.0);
   const std::vector<ImuSample> s = imu(tr, 1'900'000'000, 2'600'000'000);
   const std::vector<int64_t> f = frameTimes();
   ImuIntervalBuilder b;
@@ -168,7 +153,7 @@ TEST_CASE("an IMU gap above 3 periods is reported in its interval, not bridged s
 }
 
 TEST_CASE("a frame with no IMU before it starts no interval and is counted", "[imu][interval_builder]") {
-  const SmoothTrajectory tr = wavyTrajectory();
+  const SmoothTrajectory tr = wavyTrajectory(6.0);
   const std::vector<ImuSample> s = imu(tr, 2'030'000'000, 2'600'000'000);  // starts after the first frame
   const std::vector<int64_t> f = frameTimes();
   ImuIntervalBuilder b;

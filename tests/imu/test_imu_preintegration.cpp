@@ -8,29 +8,13 @@
 
 #include "sim/motion/imu_simulator.hpp"
 #include "sim/motion/so3.hpp"
-#include "sim/motion/waypoint_path.hpp"
+#include "tests/imu/wavy_trajectory.hpp"
 #include "stages/imu/imu_preintegration.hpp"
 
 using namespace dynavins;
 using namespace dynavins::sim;
 
 namespace {
-
-// A 3D motion with ~1 rad/s rotation rates and ~1 m/s^2 accelerations on all axes.
-SmoothTrajectory wavyTrajectory() {
-  std::vector<Waypoint> w;
-  for (int k = 0; k <= 16; ++k) {
-    const double t = 0.5 * k;
-    Waypoint p;
-    p.t = t;
-    p.p = Eigen::Vector3d(2.0 * std::sin(0.6 * t), 1.5 * std::cos(0.5 * t), 0.4 * std::sin(0.9 * t));
-    p.yaw = 0.8 * std::sin(0.7 * t);
-    p.pitch = 0.3 * std::sin(1.1 * t);
-    p.roll = 0.25 * std::cos(0.9 * t);
-    w.push_back(p);
-  }
-  return trajectoryFromTimedWaypoints(w);
-}
 
 ImuSimulation simulate(const SmoothTrajectory& tr, double rate, int64_t t0, int64_t t1,
                        ImuNoiseModel noise = ImuNoiseModel::noiseFree(), uint64_t seed = 1) {

@@ -7,28 +7,13 @@
 
 #include "sim/motion/imu_simulator.hpp"
 #include "sim/motion/so3.hpp"
-#include "sim/motion/waypoint_path.hpp"
+#include "tests/imu/wavy_trajectory.hpp"
 #include "stages/imu/imu_propagator.hpp"
 
 using namespace dynavins;
 using namespace dynavins::sim;
 
 namespace {
-
-SmoothTrajectory wavyTrajectory() {
-  std::vector<Waypoint> w;
-  for (int k = 0; k <= 12; ++k) {
-    const double t = 0.5 * k;
-    Waypoint p;
-    p.t = t;
-    p.p = Eigen::Vector3d(2.0 * std::sin(0.6 * t), 1.5 * std::cos(0.5 * t), 0.4 * std::sin(0.9 * t));
-    p.yaw = 0.8 * std::sin(0.7 * t);
-    p.pitch = 0.3 * std::sin(1.1 * t);
-    p.roll = 0.25 * std::cos(0.9 * t);
-    w.push_back(p);
-  }
-  return trajectoryFromTimedWaypoints(w);
-}
 
 NavState truthState(const SmoothTrajectory& tr, int64_t t_ns) {
   const GroundTruthState g = groundTruthAt(tr, t_ns);
@@ -52,7 +37,7 @@ Err stateError(const SmoothTrajectory& tr, const NavState& s) {
 }  // namespace
 
 TEST_CASE("propagation follows the true trajectory over 1 s, with known biases removed", "[imu][propagator]") {
-  const SmoothTrajectory tr = wavyTrajectory();
+  const SmoothTrajectory tr = wavyTrajectory(6.0);
   ImuSimulatorOptions o;
   o.noise = ImuNoiseModel::noiseFree();
   o.noise.acc_bias_initial = Eigen::Vector3d(0.1, -0.2, 0.15);
@@ -90,7 +75,7 @@ TEST_CASE("propagation follows the true trajectory over 1 s, with known biases r
 }
 
 TEST_CASE("reset with an older state replays the buffered samples", "[imu][propagator]") {
-  const SmoothTrajectory tr = wavyTrajectory();
+  const SmoothTrajectory tr = wavyTrajectory(6.0);
   ImuSimulatorOptions o;
   o.noise = ImuNoiseModel::noiseFree();
   const std::vector<ImuSample> s = ImuSimulator(o).simulate(tr, 1'000'000'000, 1'500'000'000).samples;

@@ -1,0 +1,107 @@
+// Milliseconds per stereo frame of StereoTracker (150 features, 752x480) on one core: a generated
+// street scene and the shared EuRoC V1_01 clip. Prints mean / p95 and the tracking statistics.
+#include <algorithm>
+#include <chrono>
+#include <ctime>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <numeric>
+#include <vector>
+
+#include <opencv2/core/utility.hpp>
+
+#include "io/euroc_dataset.hpp"
+#include "sim/scenario/scenario.hpp"
+#include "stages/tracker/kalibr_camera.hpp"
+#include "stages/tracker/stereo_tracker.hpp"
+
+using namespace dynavins;
+namespace fs = std::filesystem;
+
+namespace {
+
+struct Times {
+  std::vector<double> wall, cpu;
+};
+
+std::pair<double, double> mean_p95(std::vector<double> ms) {
+  const double mean = std::accumulate(ms.begin(), ms.end(), 0.0) / static_cast<double>(ms.size());
+  std::sort(ms.begin(), ms.end());
+  return {mean, ms[std::min(ms.size() - 1, static_cast<std::size_t>(0.95 * static_cast<double>(ms.size())))]};
+}
+
+void report(const char* name, const Times& t, const std::vector<TrackedFrame>& out) {
+  if (t.wall.empty()) return;
+  const auto [mean, p95] = mean_p95(t.wall);
+  const auto [cmean, cp95] = mean_p95(t.cpu);
+  double feats = 0, stereo = 0, len = 0;
+  for (const auto& f : out) {
+    feats += static_cast<double>(f.features.size());
+    stereo += f.stats.stereo;
+    for (const auto& t : f.features) len += t.track_length;
+  }
+  std::printf("%-6s frames %3zu  ms/frame wall mean %.2f p95 %.2f, thread cpu mean %.2f p95 %.2f  features/frame %.1f  stereo rate %.2f  mean track length %.1f\n",
+              name, out.size(), mean, p95, cmean, cp95, feats / static_cast<double>(out.size()), stereo / std::max(1.0, feats),
+              len / std::max(1.0, feats));
+}
+
+double thread_cpu_ms() {
+  timespec t{};
+  clock_gettime(CLOCK_THREAD_CPUTIME_ID, &t);
+  return static_cast<double>(t.tv_sec) * 1e3 + static_cast<double>(t.tv_nsec) * 1e-6;
+}
+
+/// Wall time, and this thread's CPU time: the machine is shared, so wall time includes waiting.
+template <typename F>
+void time_ms(Times* t, F&& f) {
+  const double c0 = thread_cpu_ms();
+  const auto t0 = std::chrono::steady_clock::now();
+  f();
+  t->wall.push_back(std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count());
+  t->cpu.push_back(thread_cpu_ms() - c0);
+}
+
+}  // namespace
+
+int main() {
+  cv::setNumThreads(1);  // the goal is per core; the pipeline runs other stages on the other cores
+  TrackerOptions opt;    // VINS-Fusion's EuRoC settings: 150 features, 30 px apart, flow back on
+
+  {  // Generated scene: frames rendered first so only the tracker is timed.
+    const fs::path path = fs::temp_directory_path() / "dynavins_bench_tracker.yaml";
+    std::ofstream(path) << "%YAML:1.0\n---\nname: bench\nseed: 3\nduration: 5\n"
+                           "world: { x_min: -10, x_max: 40 }\n"
+                           "motion: { profile: drone, waypoints: [0, -1.5, 1.6, 20, -1.5, 1.6] }\n"
+                           "objects:\n  - { kind: truck, motion: cross_ahead, t: 2.5, distance: 7, speed: 6 }\n";
+    sim::ScenarioSource src(sim::build_scenario(sim::load_scenario(path.string())));
+    const auto& c = src.scenario().rig.camera;
+    PinholeRadtanCamera::Params p;
+    p.width = c.width, p.height = c.height, p.fx = c.fx, p.fy = c.fy, p.cx = c.cx, p.cy = c.cy;
+    p.distortion = RadtanDistortion{c.k1, c.k2, c.p1, c.p2};
+    const auto cam = std::make_shared<const PinholeRadtanCamera>(p);
+    std::vector<StereoFrame> frames;
+    SensorEvent e;
+    while (src.next(e))
+      if (auto* f = std::get_if<StereoFrame>(&e)) frames.push_back(*f);
+    StereoTracker tracker(opt, cam, cam);
+    Times ms;
+    std::vector<TrackedFrame> out;
+    for (const auto& f : frames) time_ms(&ms, [&] { out.push_back(tracker.process(f)); });
+    report("sim", ms, out);
+  }
+  {
+    const std::string dir = std::string(DYNAVINS_SHARED_DIR) + "/data/euroc_v1_01_micro";
+    const io::EurocDataset data(dir);
+    const auto c0 = load_kalibr_camera(dir + "/mav0/cam0/sensor.yaml");
+    const auto c1 = load_kalibr_camera(dir + "/mav0/cam1/sensor.yaml");
+    std::vector<StereoFrame> frames;
+    for (std::size_t i = 0; i < data.frames().size(); ++i) frames.push_back(data.load(i));
+    StereoTracker tracker(opt, c0.camera, c1.camera);
+    Times ms;
+    std::vector<TrackedFrame> out;
+    for (const auto& f : frames) time_ms(&ms, [&] { out.push_back(tracker.process(f)); });
+    report("euroc", ms, out);
+  }
+  return 0;
+}

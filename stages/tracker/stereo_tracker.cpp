@@ -1,0 +1,278 @@
+#include "stages/tracker/stereo_tracker.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <numeric>
+#include <stdexcept>
+
+#include <opencv2/calib3d.hpp>
+#include <opencv2/video/tracking.hpp>
+
+#include "stages/tracker/corner_detector.hpp"
+
+namespace dynavins {
+
+namespace {
+
+float distance(const cv::Point2f& a, const cv::Point2f& b) { return static_cast<float>(cv::norm(a - b)); }
+
+Eigen::Vector2d to_eigen(const cv::Point2f& p) { return {p.x, p.y}; }
+
+/// Keeps the elements of `v` whose `keep` flag is set, in order.
+template <typename T>
+void compact(std::vector<T>* v, const std::vector<uchar>& keep) {
+  std::size_t j = 0;
+  for (std::size_t i = 0; i < v->size(); ++i)
+    if (keep[i]) (*v)[j++] = (*v)[i];
+  v->resize(j);
+}
+
+}  // namespace
+
+StereoTracker::StereoTracker(const TrackerOptions& options, CameraModelPtr cam0, CameraModelPtr cam1)
+    : opt_(options), cam0_(std::move(cam0)), cam1_(std::move(cam1)) {
+  if (!cam0_) throw std::invalid_argument("StereoTracker: cam0 is required");
+  if (opt_.max_cnt <= 0 || opt_.min_dist < 0 || opt_.window < 3 || opt_.pyramid_levels < 0)
+    throw std::invalid_argument("StereoTracker: bad options (max_cnt > 0, min_dist >= 0, window >= 3, levels >= 0)");
+  if (opt_.clahe) clahe_ = cv::createCLAHE(opt_.clahe_clip, cv::Size(8, 8));
+}
+
+void StereoTracker::reset() {
+  tracks_.clear();
+  prev_pyr_.clear();
+}
+
+cv::Mat StereoTracker::prepare(const cv::Mat& img) const {
+  if (img.type() != CV_8UC1) throw std::invalid_argument("StereoTracker: images must be 8-bit gray");
+  if (cam0_->width() > 0 && (img.cols != cam0_->width() || img.rows != cam0_->height()))
+    throw std::invalid_argument("StereoTracker: image size differs from the calibration's");
+  if (!clahe_) return img;
+  cv::Mat out;
+  clahe_->apply(img, out);
+  return out;
+}
+
+StereoTracker::Pyramid StereoTracker::pyramid(const cv::Mat& img) const {
+  // Built once per image and shared by the forward, backward and stereo KLT calls.
+  Pyramid pyr;
+  cv::buildOpticalFlowPyramid(img, pyr, cv::Size(opt_.window, opt_.window), opt_.pyramid_levels, true);
+  return pyr;
+}
+
+bool StereoTracker::in_border(const cv::Point2f& p, const cv::Size& size) const {
+  const int u = cvRound(p.x), v = cvRound(p.y);
+  return u >= opt_.border && v >= opt_.border && u < size.width - opt_.border && v < size.height - opt_.border;
+}
+
+std::vector<StereoTracker::Track> StereoTracker::track_temporal(const Pyramid& curr,
+                                                                const std::optional<Eigen::Matrix3d>& R_prev_curr,
+                                                                std::vector<cv::Point2f>* prev_px,
+                                                                TrackerStats* stats) const {
+  std::vector<Track> tracks = tracks_;
+  const std::size_t n = tracks.size();
+  prev_px->resize(n);
+  for (std::size_t i = 0; i < n; ++i) (*prev_px)[i] = tracks[i].px;
+  if (n == 0) return tracks;
+  const cv::Size size = curr[0].size();
+  const cv::Size win(opt_.window, opt_.window);
+  const cv::TermCriteria crit(cv::TermCriteria::COUNT | cv::TermCriteria::EPS, opt_.max_iterations, opt_.epsilon);
+
+  std::vector<cv::Point2f> px = *prev_px;
+  std::vector<uchar> status(n, 0), predicted(n, 0);
+  std::vector<float> err;
+  if (R_prev_curr) {
+    // A pure rotation moves every pixel the same whatever its depth: a good start for the fine levels.
+    const Eigen::Matrix3d R_curr_prev = R_prev_curr->transpose();
+    for (std::size_t i = 0; i < n; ++i) {
+      const Eigen::Vector3d b = R_curr_prev * tracks[i].bearing;
+      if (b.z() <= 1e-3) continue;
+      const Eigen::Vector2d q = cam0_->project(b);
+      const cv::Point2f g(static_cast<float>(q.x()), static_cast<float>(q.y()));
+      if (!in_border(g, size)) continue;
+      px[i] = g;
+      predicted[i] = 1;
+    }
+    cv::calcOpticalFlowPyrLK(prev_pyr_, curr, *prev_px, px, status, err, win, std::min(1, opt_.pyramid_levels), crit,
+                             cv::OPTFLOW_USE_INITIAL_FLOW);
+    // Retry the failures (and the unpredicted) from scratch with the whole pyramid.
+    std::vector<std::size_t> redo;
+    for (std::size_t i = 0; i < n; ++i)
+      if (!status[i] || !predicted[i]) redo.push_back(i);
+    if (!redo.empty()) {
+      std::vector<cv::Point2f> from(redo.size()), to;
+      for (std::size_t k = 0; k < redo.size(); ++k) from[k] = (*prev_px)[redo[k]];
+      std::vector<uchar> st;
+      cv::calcOpticalFlowPyrLK(prev_pyr_, curr, from, to, st, err, win, opt_.pyramid_levels, crit);
+      for (std::size_t k = 0; k < redo.size(); ++k) {
+        px[redo[k]] = to[k];
+        status[redo[k]] = st[k];
+        predicted[redo[k]] = 0;
+      }
+    }
+  } else {
+    cv::calcOpticalFlowPyrLK(prev_pyr_, curr, *prev_px, px, status, err, win, opt_.pyramid_levels, crit);
+  }
+  for (std::size_t i = 0; i < n; ++i)
+    if (status[i] && !in_border(px[i], size)) status[i] = 0;
+  for (std::size_t i = 0; i < n; ++i) stats->lost_flow += !status[i];
+
+  if (opt_.flow_back) {
+    // Back from the new pixel, starting at the old one: a track that does not come home slid.
+    std::vector<cv::Point2f> back = *prev_px;
+    std::vector<uchar> back_status;
+    cv::calcOpticalFlowPyrLK(curr, prev_pyr_, px, back, back_status, err, win, std::min(1, opt_.pyramid_levels),
+                             crit, cv::OPTFLOW_USE_INITIAL_FLOW);
+    for (std::size_t i = 0; i < n; ++i) {
+      if (!status[i]) continue;
+      if (!back_status[i] || distance(back[i], (*prev_px)[i]) > opt_.max_back_error) {
+        status[i] = 0;
+        ++stats->lost_back;
+      }
+    }
+  }
+  for (std::size_t i = 0; i < n; ++i) {
+    tracks[i].px = px[i];
+    tracks[i].length += 1;
+    stats->predicted += status[i] && predicted[i];
+  }
+  compact(&tracks, status);
+  compact(prev_px, status);
+  for (auto& t : tracks) t.bearing = cam0_->lift(to_eigen(t.px));
+  return tracks;
+}
+
+void StereoTracker::reject_with_f(std::vector<Track>* tracks, std::vector<cv::Point2f>* prev_px,
+                                  TrackerStats* stats) const {
+  if (tracks->size() < 8) return;
+  // On the undistorted plane scaled to a virtual 460 px focal length, so the threshold is in
+  // pixels of an ideal camera whatever the lens (VINS-Fusion's rejectWithF).
+  constexpr double kFocal = 460.0;
+  const double cx = cam0_->width() / 2.0, cy = cam0_->height() / 2.0;
+  std::vector<cv::Point2f> a, b;
+  for (std::size_t i = 0; i < tracks->size(); ++i) {
+    const Eigen::Vector2d p = cam0_->lift_normalized(to_eigen((*prev_px)[i]));
+    const Eigen::Vector3d& c = (*tracks)[i].bearing;
+    a.emplace_back(static_cast<float>(kFocal * p.x() + cx), static_cast<float>(kFocal * p.y() + cy));
+    b.emplace_back(static_cast<float>(kFocal * c.x() / c.z() + cx), static_cast<float>(kFocal * c.y() / c.z() + cy));
+  }
+  std::vector<uchar> inlier;
+  cv::findFundamentalMat(a, b, cv::FM_RANSAC, opt_.f_threshold, 0.99, inlier);
+  if (inlier.size() != tracks->size()) return;  // degenerate: keep everything
+  for (uchar s : inlier) stats->lost_ransac += !s;
+  compact(tracks, inlier);
+  compact(prev_px, inlier);
+}
+
+void StereoTracker::enforce_spacing_and_detect(const cv::Mat& img, std::vector<Track>* tracks,
+                                               std::vector<cv::Point2f>* prev_px, TrackerStats* stats) {
+  // Longest tracks claim their neighbourhood first (ties: the older id), so a crowding newcomer
+  // gives way to a long-lived feature and not the reverse.
+  std::vector<std::size_t> order(tracks->size());
+  std::iota(order.begin(), order.end(), 0);
+  std::stable_sort(order.begin(), order.end(), [&](std::size_t i, std::size_t j) {
+    const Track &a = (*tracks)[i], &b = (*tracks)[j];
+    return a.length != b.length ? a.length > b.length : a.id < b.id;
+  });
+  cv::Mat mask(img.size(), CV_8UC1, cv::Scalar(255));
+  const int radius = static_cast<int>(std::lround(opt_.min_dist));
+  std::vector<Track> kept;
+  std::vector<cv::Point2f> kept_prev;
+  for (std::size_t i : order) {
+    const cv::Point2f& p = (*tracks)[i].px;
+    if (static_cast<int>(kept.size()) >= opt_.max_cnt || mask.at<uchar>(cvRound(p.y), cvRound(p.x)) == 0) {
+      ++stats->lost_mask;
+      continue;
+    }
+    kept.push_back((*tracks)[i]);
+    kept_prev.push_back((*prev_px)[i]);
+    if (radius > 0) cv::circle(mask, cv::Point(cvRound(p.x), cvRound(p.y)), radius, cv::Scalar(0), cv::FILLED);
+  }
+  stats->tracked = static_cast<int>(kept.size());
+  const int wanted = opt_.max_cnt - static_cast<int>(kept.size());
+  if (wanted > 0) {
+    const std::vector<cv::Point2f> corners = detect_corners(img, mask, wanted, opt_.quality_level, opt_.min_dist);
+    for (const auto& c : corners) {
+      if (!in_border(c, img.size())) continue;
+      kept.push_back(Track{next_id_++, 1, c, cam0_->lift(to_eigen(c))});
+      kept_prev.emplace_back(std::numeric_limits<float>::quiet_NaN(), 0.f);  // new: no velocity
+      ++stats->detected;
+    }
+  }
+  *tracks = std::move(kept);
+  *prev_px = std::move(kept_prev);
+}
+
+TrackedFrame StereoTracker::process(const StereoFrame& frame, std::optional<Eigen::Matrix3d> R_prev_curr_cam0) {
+  const cv::Mat left = prepare(frame.left);
+  const bool stereo = !frame.right.empty();
+  if (stereo && !cam1_) throw std::invalid_argument("StereoTracker: a right image but no cam1 model");
+  TrackedFrame out;
+  out.t_ns = frame.t_ns;
+  out.seq = frame.seq;
+
+  Pyramid curr = pyramid(left);
+  std::vector<cv::Point2f> prev_px;
+  std::vector<Track> tracks = track_temporal(curr, R_prev_curr_cam0, &prev_px, &out.stats);
+  if (opt_.f_ransac) reject_with_f(&tracks, &prev_px, &out.stats);
+  enforce_spacing_and_detect(left, &tracks, &prev_px, &out.stats);
+
+  const double dt = prev_pyr_.empty() ? 0.0 : static_cast<double>(frame.t_ns - prev_t_ns_) * 1e-9;
+  out.features.resize(tracks.size());
+  for (std::size_t i = 0; i < tracks.size(); ++i) {
+    TrackedFeature& f = out.features[i];
+    const Track& t = tracks[i];
+    f.id = t.id;
+    f.track_length = t.length;
+    f.px = to_eigen(t.px);
+    if (dt > 0 && !std::isnan(prev_px[i].x)) f.px_velocity = (f.px - to_eigen(prev_px[i])) / dt;
+    f.bearing = t.bearing;
+    f.xy = t.bearing.head<2>() / t.bearing.z();
+  }
+
+  if (stereo && !tracks.empty()) {
+    cv::Mat right = prepare(frame.right);
+    if (right.size() != left.size()) throw std::invalid_argument("StereoTracker: left and right sizes differ");
+    if (opt_.stereo_gain_match) {
+      // KLT assumes equal brightness; the two sensors' exposure / gain differ (EuRoC: ~10 %), which
+      // pulls the left-right match off. One global gain brings the right image to the left's mean.
+      const double ml = cv::mean(left)[0], mr = cv::mean(right)[0];
+      if (mr > 1.0 && std::abs(ml / mr - 1.0) > 0.01) {
+        cv::Mat scaled;  // never in place: `right` may share the caller's pixels
+        right.convertTo(scaled, CV_8U, ml / mr);
+        right = scaled;
+      }
+    }
+    const Pyramid rpyr = pyramid(right);
+    const cv::Size win(opt_.window, opt_.window);
+    const cv::TermCriteria crit(cv::TermCriteria::COUNT | cv::TermCriteria::EPS, opt_.max_iterations, opt_.epsilon);
+    std::vector<cv::Point2f> lpx(tracks.size()), rpx, back;
+    for (std::size_t i = 0; i < tracks.size(); ++i) lpx[i] = tracks[i].px;
+    std::vector<uchar> st, back_st;
+    std::vector<float> err;
+    // Left -> right from the left pixel (no rectification, so no epipolar prior), then right ->
+    // left: a match that does not return to its start is ambiguous and left mono.
+    cv::calcOpticalFlowPyrLK(curr, rpyr, lpx, rpx, st, err, win, opt_.pyramid_levels, crit);
+    back = lpx;  // the way back starts at the answer, so the fine levels suffice (as the temporal check)
+    cv::calcOpticalFlowPyrLK(rpyr, curr, rpx, back, back_st, err, win, std::min(1, opt_.pyramid_levels), crit,
+                             cv::OPTFLOW_USE_INITIAL_FLOW);
+    for (std::size_t i = 0; i < tracks.size(); ++i) {
+      if (!st[i] || !back_st[i] || !in_border(rpx[i], right.size()) ||
+          distance(back[i], lpx[i]) > opt_.max_back_error)
+        continue;
+      TrackedFeature& f = out.features[i];
+      f.has_right = true;
+      f.px_right = to_eigen(rpx[i]);
+      f.bearing_right = cam1_->lift(f.px_right);
+      f.xy_right = f.bearing_right.head<2>() / f.bearing_right.z();
+      ++out.stats.stereo;
+    }
+  }
+
+  tracks_ = std::move(tracks);
+  prev_pyr_ = std::move(curr);
+  prev_t_ns_ = frame.t_ns;
+  return out;
+}
+
+}  // namespace dynavins

@@ -1,0 +1,64 @@
+#pragma once
+// Stereo KLT front end (VINS-Fusion's feature tracker, redone): pyramidal Lucas-Kanade on the left
+// image with a forward-backward check, Shi-Tomasi corners under a min-distance mask that keeps the
+// longest tracks, left-to-right KLT with a reverse check for the stereo observation.
+// Moving objects are tracked like the rest: rejecting them is the estimator's job.
+
+#include <optional>
+#include <vector>
+
+#include <Eigen/Core>
+#include <opencv2/core/mat.hpp>
+#include <opencv2/imgproc.hpp>
+
+#include "messages/sensor_messages.hpp"
+#include "messages/tracked_frame.hpp"
+#include "stages/common/camera_model.hpp"
+#include "stages/tracker/tracker_options.hpp"
+
+namespace dynavins {
+
+class StereoTracker {
+ public:
+  /// `cam1` may be null for mono use; then a frame with a right image throws std::invalid_argument.
+  StereoTracker(const TrackerOptions& options, CameraModelPtr cam0, CameraModelPtr cam1 = nullptr);
+
+  /// Tracks `frame` (8-bit gray left, optional right). `R_prev_curr_cam0`, the rotation of the
+  /// current cam0 frame expressed in the previous one (from the gyro), seeds each KLT with the
+  /// rotation-predicted pixel; a track that fails from there is retried from its old pixel.
+  /// Throws std::invalid_argument on a non-gray or wrongly sized image.
+  TrackedFrame process(const StereoFrame& frame, std::optional<Eigen::Matrix3d> R_prev_curr_cam0 = {});
+
+  /// Forgets every track (ids keep increasing).
+  void reset();
+
+  const TrackerOptions& options() const { return opt_; }
+
+ private:
+  using Pyramid = std::vector<cv::Mat>;
+  struct Track {
+    int64_t id;
+    int length;
+    cv::Point2f px;
+    Eigen::Vector3d bearing;
+  };
+
+  cv::Mat prepare(const cv::Mat& img) const;
+  Pyramid pyramid(const cv::Mat& img) const;
+  std::vector<Track> track_temporal(const Pyramid& curr, const std::optional<Eigen::Matrix3d>& R_prev_curr,
+                                    std::vector<cv::Point2f>* prev_px, TrackerStats* stats) const;
+  void reject_with_f(std::vector<Track>* tracks, std::vector<cv::Point2f>* prev_px, TrackerStats* stats) const;
+  void enforce_spacing_and_detect(const cv::Mat& img, std::vector<Track>* tracks, std::vector<cv::Point2f>* prev_px,
+                                  TrackerStats* stats);
+  bool in_border(const cv::Point2f& p, const cv::Size& size) const;
+
+  TrackerOptions opt_;
+  CameraModelPtr cam0_, cam1_;
+  cv::Ptr<cv::CLAHE> clahe_;
+  Pyramid prev_pyr_;
+  std::vector<Track> tracks_;
+  int64_t prev_t_ns_ = 0;
+  int64_t next_id_ = 0;
+};
+
+}  // namespace dynavins
