@@ -1,4 +1,4 @@
-// `dynavins convert --euroc DIR --out FILE.lcmlog`: a recorded data set as an LCM event log
+// `dynavins convert (--euroc DIR | --rosbag FILE.bag) --out FILE.lcmlog`: a recorded data set as an LCM event log
 // (stereo images, IMU, ground truth), the project's replayable sensor-log format. The log is
 // written to FILE.lcmlog.partial and renamed only when complete: a failed conversion leaves no
 // file that could pass for a whole log.
@@ -51,7 +51,7 @@ void run_convert(const ConvertOptions& o) {
 
 void add_convert_command(CLI::App& app) {
   auto o = std::make_shared<ConvertOptions>();
-  auto* cmd = app.add_subcommand("convert", "Convert a recorded data set (EuRoC folder) into an LCM sensor log");
+  auto* cmd = app.add_subcommand("convert", "Convert a recorded data set (EuRoC folder, ROS 1 bag) into an LCM sensor log");
   o->input.add_options(*cmd, /*with_log=*/false);
   cmd->add_option("--out", o->out, "Output LCM log")->required();
   cmd->add_flag("--raw", o->raw, "Store images as raw gray8 instead of PNG (larger, faster to read)");

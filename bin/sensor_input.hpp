@@ -1,6 +1,6 @@
 #pragma once
 // The recorded-input options shared by `convert`, `replay` and later `run`:
-// exactly one of --euroc DIR, --log FILE.lcmlog (and --rosbag FILE.bag once it is built in).
+// exactly one of --euroc DIR, --rosbag FILE.bag, --log FILE.lcmlog.
 
 #include <memory>
 #include <string>

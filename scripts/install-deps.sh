@@ -18,6 +18,8 @@ PACKAGES=(
   zlib1g-dev
   # network namespace tools for udpm tests (unshare, ip)
   util-linux iproute2
+  # ROS 1 bag import (rosbag_storage + message headers, no ROS master)
+  librosbag-storage-dev libsensor-msgs-dev libnav-msgs-dev
 )
 
 missing=()

@@ -6,13 +6,16 @@
 #
 # Defines:
 #   RosbagStorage::RosbagStorage  imported library: rosbag_storage + roscpp_serialization + rostime
-#                                 + cpp_common + console_bridge (headers under /usr/include)
+#                                 + cpp_common + console_bridge, and roslz4 + bz2 (the chunk
+#                                 codecs, for checking chunks before rosbag reads them)
 #   RosbagStorage_FOUND
 
 find_path(RosbagStorage_INCLUDE_DIR rosbag/bag.h)
 find_path(RosbagStorage_ROSCPP_INCLUDE_DIR ros/serialization.h)
 find_path(RosbagStorage_SENSOR_MSGS_INCLUDE_DIR sensor_msgs/Image.h)
 find_path(RosbagStorage_NAV_MSGS_INCLUDE_DIR nav_msgs/Odometry.h)
+find_path(RosbagStorage_ROSLZ4_INCLUDE_DIR roslz4/lz4s.h)
+find_path(RosbagStorage_BZ2_INCLUDE_DIR bzlib.h)
 # <package>:<a header it has>, each found under its nested include directory.
 set(_rosbag_nested
   pluginlib:pluginlib/class_loader.hpp
@@ -34,18 +37,23 @@ find_library(RosbagStorage_SERIALIZATION_LIBRARY roscpp_serialization)
 find_library(RosbagStorage_ROSTIME_LIBRARY rostime)
 find_library(RosbagStorage_CPP_COMMON_LIBRARY cpp_common)
 find_library(RosbagStorage_CONSOLE_BRIDGE_LIBRARY console_bridge)
+find_library(RosbagStorage_ROSLZ4_LIBRARY roslz4)
+find_library(RosbagStorage_BZ2_LIBRARY bz2)
 
 include(FindPackageHandleStandardArgs)
 find_package_handle_standard_args(RosbagStorage
   REQUIRED_VARS
     RosbagStorage_LIBRARY RosbagStorage_SERIALIZATION_LIBRARY RosbagStorage_ROSTIME_LIBRARY
     RosbagStorage_CPP_COMMON_LIBRARY RosbagStorage_CONSOLE_BRIDGE_LIBRARY
+    RosbagStorage_ROSLZ4_LIBRARY RosbagStorage_BZ2_LIBRARY
+    RosbagStorage_ROSLZ4_INCLUDE_DIR RosbagStorage_BZ2_INCLUDE_DIR
     RosbagStorage_INCLUDE_DIR RosbagStorage_ROSCPP_INCLUDE_DIR
     RosbagStorage_SENSOR_MSGS_INCLUDE_DIR RosbagStorage_NAV_MSGS_INCLUDE_DIR ${_rosbag_nested_dirs})
 
 if(RosbagStorage_FOUND AND NOT TARGET RosbagStorage::RosbagStorage)
   set(_rosbag_incs ${RosbagStorage_INCLUDE_DIR} ${RosbagStorage_ROSCPP_INCLUDE_DIR}
-    ${RosbagStorage_SENSOR_MSGS_INCLUDE_DIR} ${RosbagStorage_NAV_MSGS_INCLUDE_DIR})
+    ${RosbagStorage_SENSOR_MSGS_INCLUDE_DIR} ${RosbagStorage_NAV_MSGS_INCLUDE_DIR}
+    ${RosbagStorage_ROSLZ4_INCLUDE_DIR} ${RosbagStorage_BZ2_INCLUDE_DIR})
   foreach(_var ${_rosbag_nested_dirs})
     list(APPEND _rosbag_incs ${${_var}})
   endforeach()
@@ -55,12 +63,11 @@ if(RosbagStorage_FOUND AND NOT TARGET RosbagStorage::RosbagStorage)
     IMPORTED_LOCATION "${RosbagStorage_LIBRARY}"
     INTERFACE_INCLUDE_DIRECTORIES "${_rosbag_incs}"
     INTERFACE_LINK_LIBRARIES
-      "${RosbagStorage_SERIALIZATION_LIBRARY};${RosbagStorage_ROSTIME_LIBRARY};${RosbagStorage_CPP_COMMON_LIBRARY};${RosbagStorage_CONSOLE_BRIDGE_LIBRARY}"
-    # Boost 1.74's bind.hpp (pulled in by the ROS headers) otherwise prints a deprecation note per file.
-    INTERFACE_COMPILE_DEFINITIONS BOOST_BIND_GLOBAL_PLACEHOLDERS)
+      "${RosbagStorage_SERIALIZATION_LIBRARY};${RosbagStorage_ROSTIME_LIBRARY};${RosbagStorage_CPP_COMMON_LIBRARY};${RosbagStorage_CONSOLE_BRIDGE_LIBRARY};${RosbagStorage_ROSLZ4_LIBRARY};${RosbagStorage_BZ2_LIBRARY}")
 endif()
 mark_as_advanced(
   RosbagStorage_INCLUDE_DIR RosbagStorage_ROSCPP_INCLUDE_DIR RosbagStorage_SENSOR_MSGS_INCLUDE_DIR
   RosbagStorage_NAV_MSGS_INCLUDE_DIR RosbagStorage_LIBRARY RosbagStorage_SERIALIZATION_LIBRARY
   RosbagStorage_ROSTIME_LIBRARY RosbagStorage_CPP_COMMON_LIBRARY RosbagStorage_CONSOLE_BRIDGE_LIBRARY
+  RosbagStorage_ROSLZ4_LIBRARY RosbagStorage_BZ2_LIBRARY RosbagStorage_ROSLZ4_INCLUDE_DIR RosbagStorage_BZ2_INCLUDE_DIR
   ${_rosbag_nested_dirs})
