@@ -5,7 +5,7 @@
 #include <string>
 
 #include "sim/motion/bspline_basis.hpp"
-#include "sim/motion/so3.hpp"
+#include "stages/common/so3.hpp"
 
 namespace dynavins::sim {
 

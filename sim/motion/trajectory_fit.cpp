@@ -10,7 +10,7 @@
 #include <Eigen/SparseCore>
 
 #include "sim/motion/bspline_basis.hpp"
-#include "sim/motion/so3.hpp"
+#include "stages/common/so3.hpp"
 
 namespace dynavins::sim {
 namespace {

@@ -6,7 +6,7 @@
 #include <stdexcept>
 #include <string>
 
-#include "sim/motion/so3.hpp"
+#include "stages/common/so3.hpp"
 
 namespace dynavins::sim {
 namespace {

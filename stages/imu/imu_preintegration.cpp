@@ -4,14 +4,12 @@
 #include <stdexcept>
 #include <string>
 
+#include "stages/common/so3.hpp"
+
 namespace dynavins {
 namespace {
 
-Eigen::Matrix3d skew(const Eigen::Vector3d& a) {
-  Eigen::Matrix3d m;
-  m << 0.0, -a.z(), a.y(), a.z(), 0.0, -a.x(), -a.y(), a.x(), 0.0;
-  return m;
-}
+using so3::rightJacobian;  // Exp(φ + δ) ≈ Exp(φ) Exp(Jr(φ) δ) (Forster et al. 2017, §II-A)
 
 // Exact quaternion exponential; VINS uses the first-order (1, θ/2) form, equal to first order, so the
 // Jacobians below are unchanged while large rates lose no accuracy.
@@ -19,22 +17,6 @@ Eigen::Quaterniond expQ(const Eigen::Vector3d& theta) {
   const double a = theta.norm();
   if (a < 1e-12) return Eigen::Quaterniond(1.0, 0.5 * theta.x(), 0.5 * theta.y(), 0.5 * theta.z()).normalized();
   return Eigen::Quaterniond(Eigen::AngleAxisd(a, theta / a));
-}
-
-// Right Jacobian of SO(3): Exp(φ + δ) ≈ Exp(φ) Exp(Jr(φ) δ) (Forster et al. 2017, §II-A).
-Eigen::Matrix3d rightJacobian(const Eigen::Vector3d& phi) {
-  const double th2 = phi.squaredNorm();
-  double a, b;  // (1 - cos θ)/θ², (θ - sin θ)/θ³
-  if (th2 < 1e-10) {
-    a = 0.5 - th2 / 24.0;
-    b = 1.0 / 6.0 - th2 / 120.0;
-  } else {
-    const double th = std::sqrt(th2);
-    a = (1.0 - std::cos(th)) / th2;
-    b = (th - std::sin(th)) / (th2 * th);
-  }
-  const Eigen::Matrix3d K = skew(phi);
-  return Eigen::Matrix3d::Identity() - a * K + b * K * K;
 }
 
 }  // namespace
@@ -97,7 +79,7 @@ void ImuPreintegration::midpointStep(const ImuSample& s0, const ImuSample& s1) {
   // Jr ≈ I; the exact factors cost nothing and make F the exact derivative of the discrete step, so the bias
   // correction is second-order accurate (checked in tests/imu).
   const Eigen::Matrix3d I = Eigen::Matrix3d::Identity();
-  const Eigen::Matrix3d Ra0 = R0 * skew(a0), Ra1 = R1 * skew(a1);
+  const Eigen::Matrix3d Ra0 = R0 * so3::hat(a0), Ra1 = R1 * so3::hat(a1);
   const Eigen::Matrix3d dRt = dq.toRotationMatrix().transpose();
   const Eigen::Matrix3d Jr = rightJacobian(w * dt);
   const double dt2 = dt * dt;

@@ -7,12 +7,13 @@
 #include <vector>
 
 #include "sim/motion/imu_simulator.hpp"
-#include "sim/motion/so3.hpp"
+#include "stages/common/so3.hpp"
 #include "tests/imu/wavy_trajectory.hpp"
 #include "stages/imu/imu_preintegration.hpp"
 
 using namespace dynavins;
 using namespace dynavins::sim;
+namespace so3 = dynavins::so3;
 
 namespace {
 

@@ -5,11 +5,12 @@
 #include <cmath>
 
 #include "sim/motion/imu_simulator.hpp"
-#include "sim/motion/so3.hpp"
+#include "stages/common/so3.hpp"
 #include "sim/motion/tum_trajectory.hpp"
 #include "sim/motion/waypoint_path.hpp"
 
 using namespace dynavins::sim;
+namespace so3 = dynavins::so3;
 using dynavins::GroundTruthState;
 using dynavins::ImuSample;
 

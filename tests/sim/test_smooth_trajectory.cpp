@@ -5,9 +5,10 @@
 #include <random>
 
 #include "sim/motion/smooth_trajectory.hpp"
-#include "sim/motion/so3.hpp"
+#include "stages/common/so3.hpp"
 
 using namespace dynavins::sim;
+namespace so3 = dynavins::so3;
 
 namespace {
 

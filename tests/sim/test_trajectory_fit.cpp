@@ -5,10 +5,11 @@
 #include <cmath>
 #include <random>
 
-#include "sim/motion/so3.hpp"
+#include "stages/common/so3.hpp"
 #include "sim/motion/trajectory_fit.hpp"
 
 using namespace dynavins::sim;
+namespace so3 = dynavins::so3;
 
 namespace {
 

@@ -1,5 +1,5 @@
 #pragma once
-// Small SO(3) toolbox for the motion simulator: hat, Exp, Log and the right/left Jacobians.
+// Small SO(3) toolbox shared by the simulator and the estimator: hat, Exp, Log, right/left Jacobians.
 // Formulas: Barfoot, "State Estimation for Robotics" (2017), §7.1; Sola et al., "A micro Lie theory
 // for state estimation in robotics" (arXiv:1812.01537), eqs. (143)-(146) (right Jacobian and inverse).
 // Convention: Exp(φ) = I + sin|φ|/|φ| [φ]x + (1-cos|φ|)/|φ|^2 [φ]x^2; right Jacobian Jr satisfies
@@ -10,7 +10,7 @@
 #include <Eigen/Core>
 #include <Eigen/Geometry>
 
-namespace dynavins::sim::so3 {
+namespace dynavins::so3 {
 
 /// Skew-symmetric matrix with hat(a) * b == a.cross(b).
 inline Eigen::Matrix3d hat(const Eigen::Vector3d& a) {
@@ -91,4 +91,4 @@ inline Eigen::Matrix3d fromYawPitchRoll(double yaw, double pitch, double roll) {
       .toRotationMatrix();
 }
 
-}  // namespace dynavins::sim::so3
+}  // namespace dynavins::so3
