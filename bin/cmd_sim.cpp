@@ -42,17 +42,6 @@ std::string resolve_scenario(const std::string& name) {
   throw CommandError("scenario '" + name + "' is neither a file nor one of " + builtin.parent_path().string(), 2);
 }
 
-io::VinsStereoConfig vins_config(const sim::Scenario& s) {
-  io::VinsStereoConfig c;
-  const auto& k = s.rig.camera;
-  c.cam0 = {k.width, k.height, k.fx, k.fy, k.cx, k.cy, k.k1, k.k2, k.p1, k.p2};
-  c.cam1 = c.cam0;
-  c.body_T_cam0 = s.rig.T_body_cam0;
-  c.body_T_cam1 = s.rig.T_body_cam1;
-  c.g_norm = s.imu.gravity;
-  return c;
-}
-
 /// Left | right, and left | left with moving-object pixels tinted red.
 std::pair<cv::Mat, cv::Mat> previews(const StereoFrame& f) {
   cv::Mat raw, left, tinted, labelled;
@@ -110,7 +99,7 @@ void run_sim(const SimOptions& o) {
   cv::imwrite(o.out + "/preview_labels.png", best_preview.second);
   if (euroc) {
     euroc->close();
-    io::write_vins_stereo_config(euroc_dir + ".partial", vins_config(*scenario));
+    io::write_vins_stereo_config(euroc_dir + ".partial", sim::vins_config(*scenario));
     fs::remove_all(euroc_dir);
     fs::rename(euroc_dir + ".partial", euroc_dir);
   }

@@ -20,6 +20,9 @@ struct TrackedFeature {
   Eigen::Vector2d px_right = Eigen::Vector2d::Zero();        ///< right pixel, valid when has_right
   Eigen::Vector3d bearing_right = Eigen::Vector3d::UnitZ();  ///< unit bearing in cam1, when has_right
   Eigen::Vector2d xy_right = Eigen::Vector2d::Zero();        ///< z = 1 plane in cam1, when has_right
+  /// Simulator label at the left pixel (-1 unknown, 0 static, k moving object k). Scoring only:
+  /// the estimator must never read it.
+  int8_t sim_label = -1;
 };
 
 /// Counters of one process() call, for logs and benches.

@@ -201,4 +201,15 @@ std::string ScenarioSource::describe() const {
          std::to_string(frame_count_) + " stereo frames)";
 }
 
+io::VinsStereoConfig vins_config(const Scenario& s) {
+  io::VinsStereoConfig c;
+  const auto& k = s.rig.camera;
+  c.cam0 = {k.width, k.height, k.fx, k.fy, k.cx, k.cy, k.k1, k.k2, k.p1, k.p2};
+  c.cam1 = c.cam0;
+  c.body_T_cam0 = s.rig.T_body_cam0;
+  c.body_T_cam1 = s.rig.T_body_cam1;
+  c.g_norm = s.imu.gravity;
+  return c;
+}
+
 }  // namespace dynavins::sim

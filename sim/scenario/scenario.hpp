@@ -7,6 +7,7 @@
 #include <optional>
 
 #include "io/sensor_source.hpp"
+#include "io/vins_config_writer.hpp"
 #include "sim/motion/imu_simulator.hpp"
 #include "sim/motion/smooth_trajectory.hpp"
 #include "sim/render/photometric.hpp"
@@ -45,6 +46,9 @@ std::shared_ptr<const SmoothTrajectory> build_body_trajectory(const ScenarioSpec
 /// world's textures dominates (seconds for a long street).
 std::shared_ptr<const Scenario> build_scenario(const ScenarioSpec& spec, std::optional<uint64_t> seed = std::nullopt,
                                                std::optional<double> duration = std::nullopt);
+
+/// The scenario's rig and IMU as a VINS-Fusion stereo-inertial config (what `sim --euroc` writes).
+io::VinsStereoConfig vins_config(const Scenario& s);
 
 /// The scenario as a recording: events in time order, frames rendered on demand.
 class ScenarioSource final : public io::SensorSource {

@@ -203,9 +203,23 @@ void StereoTracker::enforce_spacing_and_detect(const cv::Mat& img, std::vector<T
   *prev_px = std::move(kept_prev);
 }
 
+namespace {
+// Copies the simulator's label under each feature's rounded left pixel (for scoring only).
+void label_features(const cv::Mat& labels, std::vector<TrackedFeature>* features) {
+  if (labels.type() != CV_8UC1) throw std::invalid_argument("StereoTracker: labels must be CV_8U (one channel)");
+  for (TrackedFeature& f : *features) {
+    const int c = static_cast<int>(std::lround(f.px.x())), r = static_cast<int>(std::lround(f.px.y()));
+    if (r < 0 || c < 0 || r >= labels.rows || c >= labels.cols) continue;
+    f.sim_label = static_cast<int8_t>(labels.at<uint8_t>(r, c));
+  }
+}
+}  // namespace
+
 TrackedFrame StereoTracker::process(const StereoFrame& frame, std::optional<Eigen::Matrix3d> R_prev_curr_cam0) {
   const cv::Mat left = prepare(frame.left);
   const bool stereo = !frame.right.empty();
+  if (!frame.labels.empty() && frame.labels.size() != frame.left.size())
+    throw std::invalid_argument("StereoTracker: label image size differs from the left image");
   if (stereo && !cam1_) throw std::invalid_argument("StereoTracker: a right image but no cam1 model");
   TrackedFrame out;
   out.t_ns = frame.t_ns;
@@ -229,6 +243,7 @@ TrackedFrame StereoTracker::process(const StereoFrame& frame, std::optional<Eige
     f.bearing = t.bearing;
     f.xy = t.bearing.head<2>() / t.bearing.z();
   }
+  if (!frame.labels.empty()) label_features(frame.labels, &out.features);
 
   if (stereo && !tracks.empty()) {
     cv::Mat right = prepare(frame.right);

@@ -1,0 +1,21 @@
+#pragma once
+// Gyroscope bias calibration from visual rotations (VINS-Mono T-RO 2018 §V-B-1 "Gyroscope Bias Calibration"):
+//   min_δbg Σ_k || Log( γ_{k,k+1}(bg + δbg)^-1 ⊗ q_bk^-1 ⊗ q_bk+1 ) ||²,  γ(bg + δbg) ≈ γ ⊗ Exp(J^γ_bg δbg),
+// one Gauss-Newton step (linear least squares in δbg).
+
+#include <vector>
+
+#include <Eigen/Core>
+
+#include "stages/imu/imu_preintegration.hpp"
+
+namespace dynavins::estimator {
+
+/// Gyroscope bias correction δbg (add it to the preintegrations' common linearisation bias).
+/// R_wb[k]: body orientations of the N+1 frames in any common reference frame (e.g. from SfM);
+/// preints[k]: preintegration from frame k to k+1 (size N; all with the same linearisation bias).
+/// Throws std::invalid_argument on mismatched sizes; returns zero when fewer than one interval.
+Eigen::Vector3d estimateGyroBias(const std::vector<Eigen::Matrix3d>& R_wb,
+                                 const std::vector<const ImuPreintegration*>& preints);
+
+}  // namespace dynavins::estimator

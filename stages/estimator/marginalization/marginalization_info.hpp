@@ -1,0 +1,107 @@
+#pragma once
+// Marginalisation of old states out of the sliding window (VINS-Mono §VI-E / VINS-Fusion's
+// MarginalizationInfo; Sibley et al., "Sliding window filter with application to planetary landing",
+// 2010, for the Schur complement). Every residual block touching a state to remove is evaluated at the
+// current estimate x0, the Gauss-Newton system H δx = -b is formed over all blocks involved (tangent
+// coordinates), the removed blocks are eliminated by the Schur complement
+//   H* = H_kk - H_km H_mm^+ H_mk,   b* = b_k - H_km H_mm^+ b_m,
+// and H*, b* are factored back into a linear residual r(x) = r0 + J (x ⊖ x0) with J^T J = H* and
+// J^T r0 = b* (eigen-decomposition H* = V S V^T: J = S^1/2 V^T, r0 = S^-1/2 V^T b*, eigenvalues below a
+// threshold dropped). MarginalizationFactor turns that residual into the prior of the next window.
+//
+// Blocks are raw double arrays (parameter_layout.hpp): ambient size 7 is a pose with a 6-dim tangent
+// (right perturbation, PoseManifold), every other size is Euclidean. No threads.
+
+#include <memory>
+#include <unordered_map>
+#include <unordered_set>
+#include <vector>
+
+#include <Eigen/Core>
+#include <ceres/cost_function.h>
+#include <ceres/loss_function.h>
+
+namespace dynavins::estimator {
+
+/// One residual block of the window that touches a state to marginalise.
+struct ResidualBlockInfo {
+  std::shared_ptr<const ceres::CostFunction> cost;
+  std::shared_ptr<const ceres::LossFunction> loss;  ///< may be null (plain least squares)
+  std::vector<double*> blocks;                      ///< parameter blocks, in the cost's order
+  std::vector<int> drop;                            ///< indices into `blocks` of the ones to marginalise
+};
+
+/// Collects residual blocks, linearises them and eliminates the dropped states (see file comment).
+/// Use: add() every block touching a dropped state, linearize(), marginalize(); then build a
+/// MarginalizationFactor on keptBlocks(shift).
+class MarginalizationInfo {
+ public:
+  /// `eigenvalue_threshold`: eigenvalues of H_mm and H* at or below it are treated as zero (the prior
+  /// carries no information along them).
+  explicit MarginalizationInfo(double eigenvalue_threshold = 1e-8);
+
+  /// Registers a residual block. A block listed in `drop` of any residual is marginalised. Throws
+  /// std::invalid_argument on a size mismatch with the cost, a bad drop index, a null cost, or a block
+  /// already seen with another size. Only before linearize().
+  void add(ResidualBlockInfo residual);
+
+  /// Evaluates every residual block at the current values of its blocks and snapshots those values
+  /// (the linearisation point x0). Robust losses are applied exactly as Ceres' solver does (its
+  /// internal Corrector, Triggs et al. "Bundle adjustment - a modern synthesis" §4.3): residual and
+  /// Jacobian are scaled by sqrt(rho'), with the second-order correction when rho'' > 0; for Huber and
+  /// Cauchy (rho'' <= 0) it is the plain sqrt(rho') weighting, so the prior holds the information the
+  /// solver itself used. Throws std::runtime_error if a cost fails to evaluate.
+  void linearize();
+
+  /// Forms H and b, takes the Schur complement onto the kept blocks and factors it into
+  /// linearizedJacobian() / linearizedResidual(). Throws std::logic_error if linearize() was not called
+  /// and std::runtime_error if no block is kept or the Schur complement has no eigenvalue above the
+  /// threshold (nothing to keep). Releases the added residual blocks (their costs and losses).
+  void marginalize();
+
+  /// Kept blocks in column order of linearizedJacobian(), at their addresses after a window shift:
+  /// `shift` maps an old address to its new one; blocks absent from the map keep their address.
+  std::vector<double*> keptBlocks(const std::unordered_map<const double*, double*>& shift = {}) const;
+  /// Ambient sizes of the kept blocks (7 = pose, else Euclidean), in column order.
+  const std::vector<int>& keptSizes() const { return kept_sizes_; }
+  /// Column offset of each kept block in linearizedJacobian() (tangent coordinates).
+  const std::vector<int>& keptTangentOffsets() const { return kept_tangent_offsets_; }
+  /// Sum of the kept blocks' tangent sizes: the columns of linearizedJacobian().
+  int keptTangentSize() const { return kept_tangent_size_; }
+  /// Values of the kept blocks at linearisation (x0), in column order.
+  const std::vector<Eigen::VectorXd>& keptLinearizationPoint() const { return kept_x0_; }
+
+  /// J (m x keptTangentSize()), m = rank of the Schur complement.
+  const Eigen::MatrixXd& linearizedJacobian() const { return linearized_jacobian_; }
+  /// r0 (m).
+  const Eigen::VectorXd& linearizedResidual() const { return linearized_residual_; }
+
+  /// Tangent size of a block of ambient size `ambient_size` (7 -> 6, else unchanged).
+  static int tangentSize(int ambient_size);
+
+ private:
+  /// A residual block's whitened residual and tangent Jacobians at x0.
+  struct Linearization {
+    Eigen::VectorXd residual;
+    std::vector<Eigen::MatrixXd> jacobians;  ///< one per block, residual rows x tangent columns
+  };
+
+  double eigenvalue_threshold_;
+  std::vector<ResidualBlockInfo> residuals_;
+  std::vector<double*> blocks_;  ///< every block seen, in order of first appearance
+  std::unordered_map<const double*, int> block_size_;
+  std::unordered_set<const double*> dropped_;
+  std::vector<Linearization> linearizations_;
+  std::unordered_map<const double*, Eigen::VectorXd> x0_;
+  bool linearized_ = false;
+
+  std::vector<double*> kept_blocks_;
+  std::vector<int> kept_sizes_;
+  std::vector<int> kept_tangent_offsets_;
+  int kept_tangent_size_ = 0;
+  std::vector<Eigen::VectorXd> kept_x0_;
+  Eigen::MatrixXd linearized_jacobian_;
+  Eigen::VectorXd linearized_residual_;
+};
+
+}  // namespace dynavins::estimator

@@ -1,0 +1,396 @@
+#include "stages/estimator/sliding_window_estimator.hpp"
+
+#include <chrono>
+#include <cmath>
+
+#include <opencv2/calib3d.hpp>
+#include <opencv2/core/eigen.hpp>
+#include <spdlog/spdlog.h>
+
+#include "stages/common/so3.hpp"
+#include "stages/estimator/initialization/gravity_alignment.hpp"
+#include "stages/estimator/initialization/gyro_bias_estimator.hpp"
+#include "stages/estimator/initialization/mono_initializer.hpp"
+#include "stages/estimator/window_features.hpp"
+#include "stages/estimator/window_optimizer.hpp"
+#include "stages/estimator/window_state.hpp"
+
+namespace dynavins::estimator {
+
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+WindowSolveOptions solveOptions(const EstimatorOptions& o, const EstimatorMode& m) {
+  WindowSolveOptions s;
+  s.loss = m.loss;
+  s.stereo = m.stereo;
+  s.max_iterations = o.max_num_iterations;
+  s.max_solver_time_s = o.max_solver_time;
+  s.gravity = o.g_norm;
+  s.weights.lambda_w = o.lambda_w;
+  s.weights.lambda_m = o.momentum_on ? o.lambda_m : 0.0;
+  s.weights.max_momentum_count = o.window_size;
+  s.alternating_converge = o.alternating_converge;
+  s.margin_feature_thresh = o.margin_feature_thresh;
+  return s;
+}
+
+Eigen::Isometry3d extrinsicOf(const std::array<double, kPoseSize>& e) {
+  Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
+  T.linear() = Eigen::Quaterniond(e[6], e[3], e[4], e[5]).toRotationMatrix();
+  T.translation() = Eigen::Vector3d(e[0], e[1], e[2]);
+  return T;
+}
+
+}  // namespace
+
+struct SlidingWindowEstimator::Impl {
+  Impl(const EstimatorOptions& o, EstimatorMode m)
+      : opt(o), mode(m), W(o.window_size), state(o.window_size), optimizer(solveOptions(o, m)) {
+    if (m.stereo && o.num_of_cam < 2) throw std::invalid_argument("stereo mode needs num_of_cam: 2 in " + o.config_file);
+    for (int c = 0; c < std::min<int>(2, static_cast<int>(o.body_T_cam.size())); ++c) {
+      const Eigen::Quaterniond q(o.body_T_cam[c].linear());
+      const Eigen::Vector3d p = o.body_T_cam[c].translation();
+      state.extrinsic[c] = {p.x(), p.y(), p.z(), q.x(), q.y(), q.z(), q.w()};
+    }
+    if (o.body_T_cam.size() < 2) state.extrinsic[1] = state.extrinsic[0];
+    T_c0c1 = extrinsicOf(state.extrinsic[0]).inverse() * extrinsicOf(state.extrinsic[1]);
+  }
+
+  WindowEstimate process(const TrackedFrame& frame, const PreintegratedInterval* imu);
+  void resetAll();
+  bool predictNewest(const PreintegratedInterval& imu, std::string* why);
+  bool initializeStereo(std::string* why);
+  bool initializeMonoWindow(std::string* why);
+  void pnpNewest();
+  std::string failureReason(const Eigen::Vector3d& last_p, const Eigen::Quaterniond& last_q);
+  void slide(bool keep_second_newest);
+  void fillOutput(WindowEstimate& e);
+  SlotCameraPose cams() const {
+    return [this](int k) { return state.camera(k, 0); };
+  }
+
+  EstimatorOptions opt;
+  EstimatorMode mode;
+  int W;
+  WindowState state;
+  WindowFeatures features;
+  WindowOptimizer optimizer;
+  Eigen::Isometry3d T_c0c1 = Eigen::Isometry3d::Identity();
+  int newest = -1;  ///< slot of the latest frame; -1 when empty
+  bool tracking = false;
+  bool gravity_aligned = false;
+};
+
+void SlidingWindowEstimator::Impl::resetAll() {
+  const auto extrinsic = state.extrinsic;  // fixed from config: survives resets
+  state = WindowState(W);
+  state.extrinsic = extrinsic;
+  features.clear();
+  optimizer.reset();
+  newest = -1;
+  tracking = false;
+  gravity_aligned = false;
+}
+
+bool SlidingWindowEstimator::Impl::predictNewest(const PreintegratedInterval& imu, std::string* why) {
+  const int i = newest - 1, j = newest;
+  if (imu.t_begin_ns != state.t_ns[i]) {
+    *why = "IMU interval starts at " + std::to_string(imu.t_begin_ns) + " ns, previous frame at " +
+           std::to_string(state.t_ns[i]) + " ns";
+    return false;
+  }
+  auto pre = std::make_unique<ImuPreintegration>(imu.preint);
+  const Eigen::Vector3d ba = state.ba(i), bg = state.bg(i);
+  if (pre->linearizedBa() != ba || pre->linearizedBg() != bg) pre->repropagate(ba, bg);
+  if (!gravity_aligned) {
+    // First IMU of the run: level the first frame with the mean specific force (VINS' initFirstIMUPose).
+    Eigen::Vector3d f = Eigen::Vector3d::Zero();
+    for (const ImuSample& smp : pre->samples()) f += smp.acc;
+    state.q(i) = Eigen::Quaterniond(gravityAlignedRotation(f / pre->samples().size()));
+    gravity_aligned = true;
+  }
+  Eigen::Vector3d alpha, beta;
+  Eigen::Quaterniond gamma;
+  pre->correctedDeltas(ba, bg, alpha, gamma, beta);
+  const double dt = pre->sumDt();
+  const Eigen::Vector3d g_w(0, 0, -opt.g_norm);
+  const Eigen::Quaterniond qi = state.q(i);
+  state.p(j) = state.p(i) + state.v(i) * dt + 0.5 * g_w * dt * dt + qi * alpha;
+  state.v(j) = state.v(i) + g_w * dt + qi * beta;
+  state.q(j) = (qi * gamma).normalized();
+  state.ba(j) = ba;
+  state.bg(j) = bg;
+  state.preint[j] = std::move(pre);
+  return true;
+}
+
+void SlidingWindowEstimator::Impl::pnpNewest() {
+  // Pose of the newest frame from the window's triangulated points (VINS-Fusion's initFramePoseByPnP),
+  // with RANSAC so that a moving object cannot drag it; the IMU prediction is the initial guess.
+  std::vector<cv::Point3f> pts;
+  std::vector<cv::Point2f> obs;
+  for (const auto& [id, f] : features.all()) {
+    if (!f.has_depth || f.start_slot >= newest || f.endSlot() != newest) continue;
+    const CameraPose a = state.camera(f.start_slot, 0);
+    const Eigen::Vector3d p_w = a.R * (Eigen::Vector3d(f.obs[0].xy.x(), f.obs[0].xy.y(), 1.0) / f.inv_depth) + a.p;
+    const Eigen::Vector2d& xy = f.obs.back().xy;
+    pts.emplace_back(p_w.x(), p_w.y(), p_w.z());
+    obs.emplace_back(xy.x(), xy.y());
+  }
+  if (pts.size() < 10) return;
+  const CameraPose guess = state.camera(newest, 0);
+  const Eigen::Matrix3d R_cw = guess.R.transpose();
+  const Eigen::Vector3d t_cw = -R_cw * guess.p;
+  cv::Mat R_cv, rvec, tvec;
+  cv::eigen2cv(R_cw, R_cv);
+  cv::Rodrigues(R_cv, rvec);
+  cv::eigen2cv(t_cw, tvec);
+  std::vector<int> inliers;
+  const bool ok = cv::solvePnPRansac(pts, obs, cv::Mat::eye(3, 3, CV_64F), cv::noArray(), rvec, tvec, true, 100,
+                                     3.0 / kNominalFocalPx, 0.99, inliers, cv::SOLVEPNP_ITERATIVE);
+  if (!ok || inliers.size() < 10) return;
+  cv::Rodrigues(rvec, R_cv);
+  Eigen::Matrix3d R_cw_new;
+  Eigen::Vector3d t_cw_new;
+  cv::cv2eigen(R_cv, R_cw_new);
+  cv::cv2eigen(tvec, t_cw_new);
+  // cam pose -> body pose through the fixed extrinsic.
+  const Eigen::Isometry3d T_bc = extrinsicOf(state.extrinsic[0]);
+  const Eigen::Matrix3d R_wc = R_cw_new.transpose();
+  const Eigen::Vector3d p_wc = -R_wc * t_cw_new;
+  const Eigen::Matrix3d R_wb = R_wc * T_bc.linear().transpose();
+  state.q(newest) = Eigen::Quaterniond(R_wb).normalized();
+  state.p(newest) = p_wc - R_wb * T_bc.translation();
+}
+
+bool SlidingWindowEstimator::Impl::initializeStereo(std::string* why) {
+  // VINS-Fusion's stereo-inertial start: poses by PnP on stereo points while the window fills, then the
+  // gyroscope bias from those rotations, velocities from the positions, and a full window solve.
+  int with_depth = 0;
+  for (const auto& [id, f] : features.all()) with_depth += f.has_depth ? 1 : 0;
+  if (with_depth < 30) {
+    *why = "only " + std::to_string(with_depth) + " stereo points in the window";
+    return false;
+  }
+  std::vector<Eigen::Matrix3d> R_wb;
+  std::vector<const ImuPreintegration*> pre;
+  for (int k = 0; k <= newest; ++k) {
+    R_wb.push_back(state.q(k).toRotationMatrix());
+    if (k > 0) pre.push_back(state.preint[k].get());
+  }
+  const Eigen::Vector3d dbg = estimateGyroBias(R_wb, pre);
+  if (dbg.norm() > 0.5) {
+    *why = "gyroscope bias estimate " + std::to_string(dbg.norm()) + " rad/s is implausible";
+    return false;
+  }
+  for (int k = 0; k <= newest; ++k) {
+    state.bg(k) += dbg;
+    if (k > 0) state.preint[k]->repropagate(state.ba(k - 1), state.bg(k - 1));
+  }
+  // Velocities by central differences of the PnP positions (the solve refines them with the IMU).
+  for (int k = 0; k <= newest; ++k) {
+    const int a = std::max(0, k - 1), b = std::min(newest, k + 1);
+    const double dt = (state.t_ns[b] - state.t_ns[a]) * 1e-9;
+    if (dt > 0) state.v(k) = (state.p(b) - state.p(a)) / dt;
+  }
+  return true;
+}
+
+bool SlidingWindowEstimator::Impl::initializeMonoWindow(std::string* why) {
+  std::vector<InitWindowFrame> window(newest + 1);
+  for (int k = 0; k <= newest; ++k) {
+    window[k].t = state.t_ns[k] * 1e-9;
+    window[k].preint = k > 0 ? state.preint[k].get() : nullptr;
+  }
+  for (const auto& [id, f] : features.all()) {
+    for (size_t o = 0; o < f.obs.size(); ++o) window[f.start_slot + o].features[static_cast<int>(id)] = f.obs[o].xy;
+  }
+  const Eigen::Isometry3d T_bc = extrinsicOf(state.extrinsic[0]);
+  MonoInitOptions mo;
+  mo.alignment.gravity_norm = opt.g_norm;
+  const MonoInitResult r = initializeMono(window, T_bc.linear(), T_bc.translation(), mo);
+  if (!r.success) {
+    *why = r.reason;
+    return false;
+  }
+  for (int k = 0; k <= newest; ++k) {
+    state.q(k) = Eigen::Quaterniond(r.R_wb[k]).normalized();
+    state.p(k) = r.p_wb[k];
+    state.v(k) = r.v_wb[k];
+    state.bg(k) = r.bg;
+  }
+  for (auto& [id, f] : features.all()) {
+    f.has_depth = false;
+    auto it = r.depths.find(static_cast<int>(id));
+    if (it != r.depths.end() && it->second.anchor_frame == f.start_slot && it->second.depth > 0.1) {
+      f.inv_depth = 1.0 / it->second.depth;
+      f.has_depth = true;
+    }
+  }
+  return true;
+}
+
+std::string SlidingWindowEstimator::Impl::failureReason(const Eigen::Vector3d& last_p,
+                                                        const Eigen::Quaterniond& last_q) {
+  // VINS-Fusion's failureDetection thresholds.
+  if (features.lastTrackedCount() < 2) return "fewer than 2 features tracked";
+  if (state.ba(newest).norm() > 2.5) return "accelerometer bias estimate above 2.5 m/s^2";
+  if (state.bg(newest).norm() > 1.0) return "gyroscope bias estimate above 1 rad/s";
+  const Eigen::Vector3d dp = state.p(newest) - last_p;
+  if (dp.norm() > 5.0) return "position jumped more than 5 m in one frame";
+  if (std::abs(dp.z()) > 1.0) return "height jumped more than 1 m in one frame";
+  const double angle = Eigen::AngleAxisd(last_q.conjugate() * state.q(newest)).angle();
+  if (angle > 50.0 * M_PI / 180.0) return "orientation jumped more than 50 degrees in one frame";
+  return {};
+}
+
+void SlidingWindowEstimator::Impl::slide(bool keep_second_newest) {
+  if (keep_second_newest) {
+    if (tracking) optimizer.marginalizeOldest(state, newest, features);
+    features.removeOldest(cams());
+    for (int k = 0; k < newest; ++k) state.moveSlot(k + 1, k);
+    state.preint[0].reset();
+  } else {
+    if (tracking) optimizer.marginalizeSecondNewest(state, newest);
+    // Fold the newest interval into the second newest's so the IMU chain stays unbroken.
+    ImuPreintegration& merged = *state.preint[newest - 1];
+    const auto& samples = state.preint[newest]->samples();
+    for (size_t k = 1; k < samples.size(); ++k) merged.integrate(samples[k]);
+    features.removeSlot(newest - 1, cams());
+    auto keep = std::move(state.preint[newest - 1]);
+    state.moveSlot(newest, newest - 1);
+    state.preint[newest - 1] = std::move(keep);
+  }
+  state.preint[newest].reset();
+  --newest;
+}
+
+void SlidingWindowEstimator::Impl::fillOutput(WindowEstimate& e) {
+  e.status = EstimatorStatus::Tracking;
+  NavState& ns = e.state;
+  ns.t_ns = state.t_ns[newest];
+  ns.p_wb = state.p(newest);
+  ns.q_wb = state.q(newest);
+  ns.v_wb = state.v(newest);
+  ns.bias_acc = state.ba(newest);
+  ns.bias_gyr = state.bg(newest);
+  e.features.t_ns = ns.t_ns;
+  for (const auto& [id, f] : features.all()) {
+    if (!f.inBa() || f.times_solved == 0) continue;
+    const CameraPose a = state.camera(f.start_slot, 0);
+    WeightedFeature wf;
+    wf.id = id;
+    wf.u = static_cast<float>(f.obs.back().px.x());
+    wf.v = static_cast<float>(f.obs.back().px.y());
+    wf.p_w = a.R * (Eigen::Vector3d(f.obs[0].xy.x(), f.obs[0].xy.y(), 1.0) / f.inv_depth) + a.p;
+    wf.weight = static_cast<float>(mode.loss == BaLoss::Dynavins ? f.weight : 1.0);
+    wf.times_solved = f.times_solved;
+    wf.sim_label = f.sim_label;
+    e.features.features.push_back(wf);
+  }
+}
+
+WindowEstimate SlidingWindowEstimator::Impl::process(const TrackedFrame& frame, const PreintegratedInterval* imu) {
+  const auto t0 = Clock::now();
+  WindowEstimate e;
+  e.t_ns = frame.t_ns;
+  e.seq = frame.seq;
+  auto finish = [&](WindowEstimate& out) -> WindowEstimate {
+    out.solve.total_ms = std::chrono::duration<double, std::milli>(Clock::now() - t0).count();
+    return out;
+  };
+  auto fail = [&](const std::string& why) -> WindowEstimate {
+    spdlog::warn("estimator reset at t={:.3f} s: {}", frame.t_ns * 1e-9, why);
+    const bool was_tracking = tracking;
+    resetAll();
+    e.status = was_tracking ? EstimatorStatus::Reset : EstimatorStatus::Initializing;
+    e.event = "reset: " + why;
+    return finish(e);
+  };
+
+  if (newest >= 0 && imu == nullptr) return fail("no IMU between frames");
+  if (imu && imu->has_gap && imu->max_gap_ns > 100'000'000) {
+    return fail("IMU gap of " + std::to_string(imu->max_gap_ns / 1'000'000) + " ms");
+  }
+  if (imu && imu->has_gap) e.event = "imu gap of " + std::to_string(imu->max_gap_ns / 1'000'000) + " ms bridged";
+
+  // Place the frame in the next slot, with its IMU-predicted state.
+  ++newest;
+  state.t_ns[newest] = frame.t_ns;
+  if (newest > 0) {
+    std::string why;
+    if (!predictNewest(*imu, &why)) return fail(why);
+  }
+  const Eigen::Vector3d last_p = newest > 0 ? Eigen::Vector3d(state.p(newest - 1)) : Eigen::Vector3d::Zero();
+  const Eigen::Quaterniond last_q = newest > 0 ? state.q(newest - 1) : Eigen::Quaterniond::Identity();
+  const bool keep_second_newest =
+      features.addFrame(newest, frame, opt.keyframe_parallax / kNominalFocalPx, mode.stereo);
+
+  if (!tracking) {
+    if (mode.stereo) {
+      features.triangulate(cams(), T_c0c1, true);
+      if (newest > 0) pnpNewest();
+      features.triangulate(cams(), T_c0c1, true);
+    }
+    if (newest < W) return finish(e);  // still filling the window
+    std::string why;
+    const bool ok = mode.stereo ? initializeStereo(&why) : initializeMonoWindow(&why);
+    if (!ok) {
+      spdlog::debug("initialisation at t={:.3f} s not yet: {}", frame.t_ns * 1e-9, why);
+      slide(true);  // drop the oldest and keep collecting
+      return finish(e);
+    }
+    e.solve = optimizer.solve(state, newest, features);
+    tracking = true;
+    e.event = "initialized";
+    spdlog::info("estimator initialised at t={:.3f} s ({} mode, {} BA)", frame.t_ns * 1e-9,
+                 mode.stereo ? "stereo" : "mono", toString(mode.loss));
+  } else {
+    features.triangulate(cams(), T_c0c1, mode.stereo);
+    e.solve = optimizer.solve(state, newest, features);
+    features.removeBadDepths();
+    const std::string why = failureReason(last_p, last_q);
+    if (!why.empty()) return fail(why);
+  }
+  spdlog::debug("t={:.3f} p=({:.3f},{:.3f},{:.3f}) v=({:.3f},{:.3f},{:.3f}) ba={:.3f} bg={:.4f} ba_ms={:.1f} it={} alt={} feats={} kf={}",
+                frame.t_ns * 1e-9, state.p(newest).x(), state.p(newest).y(), state.p(newest).z(), state.v(newest).x(),
+                state.v(newest).y(), state.v(newest).z(), state.ba(newest).norm(), state.bg(newest).norm(), e.solve.ba_ms,
+                e.solve.ceres_iterations, e.solve.alternations, e.solve.features_in_window, keep_second_newest);
+  e.keyframe = keep_second_newest;
+  fillOutput(e);
+  const auto t_m = Clock::now();
+  slide(keep_second_newest);
+  e.solve.marginalization_ms = std::chrono::duration<double, std::milli>(Clock::now() - t_m).count();
+  return finish(e);
+}
+
+SlidingWindowEstimator::SlidingWindowEstimator(const EstimatorOptions& options, EstimatorMode mode)
+    : impl_(std::make_unique<Impl>(options, mode)) {}
+SlidingWindowEstimator::~SlidingWindowEstimator() = default;
+SlidingWindowEstimator::SlidingWindowEstimator(SlidingWindowEstimator&&) noexcept = default;
+SlidingWindowEstimator& SlidingWindowEstimator::operator=(SlidingWindowEstimator&&) noexcept = default;
+
+WindowEstimate SlidingWindowEstimator::process(const TrackedFrame& frame, const PreintegratedInterval* imu) {
+  return impl_->process(frame, imu);
+}
+
+NavState SlidingWindowEstimator::latestState() const {
+  NavState s;
+  const Impl& m = *impl_;
+  if (m.newest < 0) return s;
+  // After a slide the newest frame sits one slot down.
+  const int k = m.newest;
+  s.t_ns = m.state.t_ns[k];
+  s.p_wb = m.state.p(k);
+  s.q_wb = m.state.q(k);
+  s.v_wb = Eigen::Map<const Eigen::Vector3d>(m.state.speed_bias[k].data());
+  s.bias_acc = Eigen::Map<const Eigen::Vector3d>(m.state.speed_bias[k].data() + 3);
+  s.bias_gyr = Eigen::Map<const Eigen::Vector3d>(m.state.speed_bias[k].data() + 6);
+  return s;
+}
+
+bool SlidingWindowEstimator::tracking() const { return impl_->tracking; }
+
+}  // namespace dynavins::estimator

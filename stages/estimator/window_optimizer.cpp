@@ -1,0 +1,267 @@
+#include "stages/estimator/window_optimizer.hpp"
+
+#include <chrono>
+#include <cmath>
+#include <unordered_map>
+
+#include <ceres/ceres.h>
+#include <spdlog/spdlog.h>
+
+#include "stages/estimator/factors/imu_factor.hpp"
+#include "stages/estimator/factors/reprojection_factors.hpp"
+#include "stages/estimator/marginalization/marginalization_factor.hpp"
+#include "stages/estimator/marginalization/marginalization_info.hpp"
+#include "stages/estimator/pose_manifold.hpp"
+
+namespace dynavins::estimator {
+
+namespace {
+
+using Clock = std::chrono::steady_clock;
+double msSince(Clock::time_point t0) {
+  return std::chrono::duration<double, std::milli>(Clock::now() - t0).count();
+}
+
+/// One visual residual of a feature: its cost, blocks, and whether DynaVINS weights it.
+struct VisualResidual {
+  std::shared_ptr<ceres::CostFunction> cost;
+  std::vector<double*> blocks;
+  bool weighted = false;
+  int anchor_block = 0;  ///< index in `blocks` of the anchor pose (-1 for the stereo residual)
+};
+
+/// Every reprojection residual of `f` (paper III-D: the same-frame stereo residual is never weighted).
+std::vector<VisualResidual> visualResiduals(WindowState& s, WindowFeature& f, const WindowSolveOptions& o) {
+  std::vector<VisualResidual> out;
+  const bool dyn = o.loss == BaLoss::Dynavins;
+  const double* w = dyn ? &f.weight : nullptr;
+  const int i = f.start_slot;
+  const Eigen::Vector2d& xy_i = f.obs[0].xy;
+  double* pose_i = s.pose[i].data();
+  double* ex0 = s.extrinsic[0].data();
+  double* ex1 = s.extrinsic[1].data();
+  for (size_t k = 0; k < f.obs.size(); ++k) {
+    const int j = i + static_cast<int>(k);
+    const FeatureObservation& o_j = f.obs[k];
+    if (j != i) {
+      out.push_back({std::make_shared<ProjectionTwoFrameOneCamFactor>(xy_i, o_j.xy, o.sqrt_info, w),
+                     {pose_i, s.pose[j].data(), ex0, &f.inv_depth}, dyn, 0});
+    }
+    if (!o.stereo || !o_j.has_right) continue;
+    if (j != i) {
+      out.push_back({std::make_shared<ProjectionTwoFrameTwoCamFactor>(xy_i, o_j.xy_right, o.sqrt_info, w),
+                     {pose_i, s.pose[j].data(), ex0, ex1, &f.inv_depth}, dyn, 0});
+    } else {
+      out.push_back({std::make_shared<ProjectionOneFrameTwoCamFactor>(xy_i, o_j.xy_right, o.sqrt_info),
+                     {ex0, ex1, &f.inv_depth}, false, -1});
+    }
+  }
+  return out;
+}
+
+/// VINS-Fusion's loss: Huber with delta 1 (one noise sigma) on every visual residual in huber mode; in
+/// dynavins mode the weights replace it (eq. 4), and only the unweighted stereo residual keeps it.
+std::shared_ptr<ceres::LossFunction> lossFor(const VisualResidual& r, const WindowSolveOptions& o) {
+  if (o.loss == BaLoss::Dynavins && r.weighted) return nullptr;
+  return std::make_shared<ceres::HuberLoss>(1.0);
+}
+
+bool imuUsable(const WindowState& s, int k) { return s.preint[k] && s.preint[k]->sumDt() < 10.0; }
+
+}  // namespace
+
+bool WindowOptimizer::marginalizeOrDrop(MarginalizationInfo& info) {
+  try {
+    info.marginalize();
+    return true;
+  } catch (const std::runtime_error& e) {
+    // Nothing informative left to keep (e.g. every factor rejected): the window goes on without a prior.
+    spdlog::warn("marginalisation dropped the prior: {}", e.what());
+    reset();
+    return false;
+  }
+}
+
+WindowOptimizer::WindowOptimizer(WindowSolveOptions options) : opt_(options) {}
+WindowOptimizer::~WindowOptimizer() = default;
+
+void WindowOptimizer::reset() {
+  prior_.reset();
+  prior_blocks_.clear();
+}
+
+double WindowOptimizer::featureResidual(const WindowState& s, const WindowFeature& f) const {
+  const CameraPose anchor = s.camera(f.start_slot, 0);
+  const Eigen::Vector3d p_w =
+      anchor.R * (Eigen::Vector3d(f.obs[0].xy.x(), f.obs[0].xy.y(), 1.0) / f.inv_depth) + anchor.p;
+  auto squared = [&](const CameraPose& c, const Eigen::Vector2d& xy) {
+    const Eigen::Vector3d p_c = c.R.transpose() * (p_w - c.p);
+    if (p_c.z() <= 1e-3) return 1e4;  // behind the camera: as bad as it gets
+    return (opt_.sqrt_info * (p_c.head<2>() / p_c.z() - xy)).squaredNorm();
+  };
+  std::vector<double> sq;
+  for (size_t k = 1; k < f.obs.size(); ++k) {
+    const int j = f.start_slot + static_cast<int>(k);
+    sq.push_back(squared(s.camera(j, 0), f.obs[k].xy));
+    if (opt_.stereo && f.obs[k].has_right) sq.push_back(squared(s.camera(j, 1), f.obs[k].xy_right));
+  }
+  return meanSquaredResidual(sq);
+}
+
+SolveStats WindowOptimizer::solve(WindowState& s, int newest, WindowFeatures& features) {
+  SolveStats st;
+  const auto t_ba = Clock::now();
+
+  ceres::Problem::Options po;
+  po.cost_function_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
+  po.loss_function_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
+  po.manifold_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
+  ceres::Problem problem(po);
+  PoseManifold pose_manifold;
+  std::vector<std::shared_ptr<ceres::CostFunction>> costs;  // alive until the problem goes
+  std::vector<std::shared_ptr<ceres::LossFunction>> losses;
+
+  for (int k = 0; k <= newest; ++k) {
+    problem.AddParameterBlock(s.pose[k].data(), kPoseSize, &pose_manifold);
+    problem.AddParameterBlock(s.speed_bias[k].data(), kSpeedBiasSize);
+  }
+  for (int c = 0; c < (opt_.stereo ? 2 : 1); ++c) {
+    problem.AddParameterBlock(s.extrinsic[c].data(), kPoseSize, &pose_manifold);
+    problem.SetParameterBlockConstant(s.extrinsic[c].data());  // fixed from config
+  }
+  if (prior_) {
+    auto cost = std::make_shared<MarginalizationFactor>(prior_);
+    costs.push_back(cost);
+    problem.AddResidualBlock(cost.get(), nullptr, prior_blocks_);
+  }
+  for (int k = 1; k <= newest; ++k) {
+    if (!imuUsable(s, k)) continue;
+    auto cost = std::make_shared<ImuFactor>(s.preint[k].get(), opt_.gravity);
+    costs.push_back(cost);
+    problem.AddResidualBlock(cost.get(), nullptr, s.pose[k - 1].data(), s.speed_bias[k - 1].data(),
+                             s.pose[k].data(), s.speed_bias[k].data());
+  }
+  std::vector<WindowFeature*> in_ba;
+  for (auto& [id, f] : features.all()) {
+    if (!f.inBa() || f.start_slot > newest) continue;
+    in_ba.push_back(&f);
+    for (VisualResidual& r : visualResiduals(s, f, opt_)) {
+      auto loss = lossFor(r, opt_);
+      if (loss) losses.push_back(loss);
+      costs.push_back(r.cost);
+      problem.AddResidualBlock(r.cost.get(), loss.get(), r.blocks);
+    }
+  }
+  st.features_in_window = static_cast<int>(in_ba.size());
+
+  ceres::Solver::Options so;
+  so.linear_solver_type = ceres::DENSE_SCHUR;
+  so.trust_region_strategy_type = ceres::DOGLEG;
+  so.num_threads = 1;  // stage libraries start no threads (pipeline/ does)
+  so.logging_type = ceres::SILENT;
+
+  const bool dyn = opt_.loss == BaLoss::Dynavins;
+  int budget = opt_.max_iterations;
+  double time_left = opt_.max_solver_time_s;
+  auto runSolver = [&](int iterations) {
+    so.max_num_iterations = std::max(1, iterations);
+    so.max_solver_time_in_seconds = std::max(1e-3, time_left);
+    ceres::Solver::Summary summary;
+    ceres::Solve(so, &problem, &summary);
+    const int used = summary.num_successful_steps + summary.num_unsuccessful_steps;
+    st.ceres_iterations += used;
+    budget -= std::max(1, used);
+    time_left -= summary.total_time_in_seconds;
+    ++st.alternations;
+    return summary.termination_type == ceres::CONVERGENCE;
+  };
+  // Weight step (eq. 10 in closed form); returns the share of weights that moved less than the tolerance.
+  auto weightStep = [&]() {
+    const auto t0 = Clock::now();
+    int settled = 0;
+    for (WindowFeature* f : in_ba) {
+      const double w = solveFeatureWeight(featureResidual(s, *f), f->weight_prev, f->times_solved, opt_.weights);
+      if (std::abs(w - f->weight) < opt_.settle_tolerance) ++settled;
+      f->weight = w;
+    }
+    st.weight_ms += msSince(t0);
+    return in_ba.empty() ? 1.0 : static_cast<double>(settled) / in_ba.size();
+  };
+
+  if (!dyn) {
+    runSolver(budget);
+  } else {
+    // Start from the previous weights (momentum's w̄) so "settled" compares against where we were.
+    for (WindowFeature* f : in_ba) f->weight = f->weight_prev;
+    weightStep();
+    for (int a = 0; a < opt_.max_alternations && budget > 0 && time_left > 0; ++a) {
+      const bool last = a + 1 == opt_.max_alternations;
+      const bool converged = runSolver(last ? budget : std::max(2, budget / 2));
+      const double settled = weightStep();
+      if (settled >= opt_.alternating_converge && converged) break;
+    }
+    for (WindowFeature* f : in_ba) {
+      f->weight_prev = f->weight;
+      ++f->times_solved;
+    }
+  }
+  st.ba_ms = msSince(t_ba);
+  return st;
+}
+
+void WindowOptimizer::marginalizeOldest(WindowState& s, int newest, WindowFeatures& features) {
+  auto info = std::make_shared<MarginalizationInfo>();
+  double* pose0 = s.pose[0].data();
+  double* sb0 = s.speed_bias[0].data();
+  if (prior_) {
+    std::vector<int> drop;
+    for (size_t b = 0; b < prior_blocks_.size(); ++b) {
+      if (prior_blocks_[b] == pose0 || prior_blocks_[b] == sb0) drop.push_back(static_cast<int>(b));
+    }
+    info->add({std::make_shared<MarginalizationFactor>(prior_), nullptr, prior_blocks_, drop});
+  }
+  if (imuUsable(s, 1)) {
+    info->add({std::make_shared<ImuFactor>(s.preint[1].get(), opt_.gravity), nullptr,
+               {pose0, sb0, s.pose[1].data(), s.speed_bias[1].data()}, {0, 1}});
+  }
+  for (auto& [id, f] : features.all()) {
+    if (f.start_slot != 0 || !f.inBa()) continue;
+    // A feature the robust BA rejected would poison the prior forever (paper III; margin_feature_thresh).
+    if (opt_.loss == BaLoss::Dynavins && f.weight < opt_.margin_feature_thresh) continue;
+    for (VisualResidual& r : visualResiduals(s, f, opt_)) {
+      std::vector<int> drop{static_cast<int>(r.blocks.size()) - 1};  // the inverse depth
+      if (r.anchor_block >= 0) drop.push_back(r.anchor_block);
+      info->add({r.cost, lossFor(r, opt_), r.blocks, drop});
+    }
+  }
+  info->linearize();  // evaluates now, while the features' weights are alive
+  if (!marginalizeOrDrop(*info)) return;
+  std::unordered_map<const double*, double*> shift;
+  for (int k = 1; k <= newest; ++k) {
+    shift[s.pose[k].data()] = s.pose[k - 1].data();
+    shift[s.speed_bias[k].data()] = s.speed_bias[k - 1].data();
+  }
+  prior_blocks_ = info->keptBlocks(shift);
+  prior_ = info;
+}
+
+void WindowOptimizer::marginalizeSecondNewest(WindowState& s, int newest) {
+  if (!prior_) return;
+  double* pose_drop = s.pose[newest - 1].data();
+  std::vector<int> drop;
+  for (size_t b = 0; b < prior_blocks_.size(); ++b) {
+    if (prior_blocks_[b] == pose_drop) drop.push_back(static_cast<int>(b));
+  }
+  if (drop.empty()) return;  // the prior does not involve that frame: nothing to do
+  auto info = std::make_shared<MarginalizationInfo>();
+  info->add({std::make_shared<MarginalizationFactor>(prior_), nullptr, prior_blocks_, drop});
+  info->linearize();
+  if (!marginalizeOrDrop(*info)) return;
+  std::unordered_map<const double*, double*> shift;
+  shift[s.pose[newest].data()] = s.pose[newest - 1].data();
+  shift[s.speed_bias[newest].data()] = s.speed_bias[newest - 1].data();
+  prior_blocks_ = info->keptBlocks(shift);
+  prior_ = info;
+}
+
+}  // namespace dynavins::estimator

@@ -1,0 +1,589 @@
+// MarginalizationInfo / MarginalizationFactor: the prior left by marginalising states reproduces the full
+// problem's solution and covariance (linear-Gaussian), keeps a nonlinear pose graph at its optimum, has
+// exact Jacobians, ignores unrelated dropped blocks, weights by the robust loss, and keeps its block order.
+#include "tests/estimator/catch_with_ceres.hpp"  // first: Catch's CHECK, not glog's
+
+#include <array>
+#include <functional>
+#include <memory>
+#include <random>
+#include <set>
+#include <vector>
+
+#include <Eigen/Dense>
+#include <ceres/ceres.h>
+
+#include "stages/common/so3.hpp"
+#include "stages/estimator/marginalization/marginalization_factor.hpp"
+#include "stages/estimator/marginalization/marginalization_info.hpp"
+#include "stages/estimator/pose_manifold.hpp"
+
+using namespace dynavins;
+using namespace dynavins::estimator;
+
+namespace {
+
+using RowMajor = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>;
+
+Eigen::MatrixXd randomMatrix(int rows, int cols, std::mt19937& rng, double scale = 1.0) {
+  std::uniform_real_distribution<double> u(-scale, scale);
+  Eigen::MatrixXd m(rows, cols);
+  for (int i = 0; i < rows; ++i)
+    for (int j = 0; j < cols; ++j) m(i, j) = u(rng);
+  return m;
+}
+
+/// r = Σ_k A_k x_k - c over Euclidean blocks.
+class LinearFactor final : public ceres::CostFunction {
+ public:
+  LinearFactor(std::vector<Eigen::MatrixXd> a, Eigen::VectorXd c) : a_(std::move(a)), c_(std::move(c)) {
+    for (const auto& ak : a_) mutable_parameter_block_sizes()->push_back(static_cast<int>(ak.cols()));
+    set_num_residuals(static_cast<int>(c_.size()));
+  }
+  bool Evaluate(double const* const* x, double* r, double** jac) const override {
+    Eigen::Map<Eigen::VectorXd> res(r, c_.size());
+    res = -c_;
+    for (size_t k = 0; k < a_.size(); ++k) {
+      res += a_[k] * Eigen::Map<const Eigen::VectorXd>(x[k], a_[k].cols());
+      if (jac && jac[k]) Eigen::Map<RowMajor>(jac[k], a_[k].rows(), a_[k].cols()) = a_[k];
+    }
+    return true;
+  }
+  const std::vector<Eigen::MatrixXd>& a() const { return a_; }
+  const Eigen::VectorXd& c() const { return c_; }
+
+ private:
+  std::vector<Eigen::MatrixXd> a_;
+  Eigen::VectorXd c_;
+};
+
+using ResidualFn = std::function<Eigen::VectorXd(const std::vector<const double*>&)>;
+
+/// Tangent Jacobian by central differences: size-7 blocks perturbed through PoseManifold::Plus and
+/// written in the first 6 columns (column 7 zero), others additively — the estimator's convention.
+void tangentNumericJacobians(const ResidualFn& f, const std::vector<int>& sizes, double const* const* x,
+                             int rows, double** jac) {
+  const PoseManifold pose;
+  const double h = 1e-6;
+  std::vector<std::vector<double>> values(sizes.size());
+  std::vector<const double*> ptrs(sizes.size());
+  for (size_t i = 0; i < sizes.size(); ++i) {
+    values[i].assign(x[i], x[i] + sizes[i]);
+    ptrs[i] = values[i].data();
+  }
+  for (size_t i = 0; i < sizes.size(); ++i) {
+    if (!jac[i]) continue;
+    Eigen::Map<RowMajor> ji(jac[i], rows, sizes[i]);
+    ji.setZero();
+    const int tangent = MarginalizationInfo::tangentSize(sizes[i]);
+    for (int k = 0; k < tangent; ++k) {
+      Eigen::VectorXd r_pm[2];
+      for (int s = 0; s < 2; ++s) {
+        Eigen::VectorXd delta = Eigen::VectorXd::Zero(tangent);
+        delta(k) = s == 0 ? h : -h;
+        if (sizes[i] == 7) {
+          pose.Plus(x[i], delta.data(), values[i].data());
+        } else {
+          for (int d = 0; d < sizes[i]; ++d) values[i][d] = x[i][d] + delta(d);
+        }
+        r_pm[s] = f(ptrs);
+      }
+      values[i].assign(x[i], x[i] + sizes[i]);
+      ji.col(k) = (r_pm[0] - r_pm[1]) / (2.0 * h);
+    }
+  }
+}
+
+/// A cost from a residual function with numeric tangent Jacobians.
+class NumericTangentCost final : public ceres::CostFunction {
+ public:
+  NumericTangentCost(ResidualFn f, std::vector<int> sizes, int rows) : f_(std::move(f)) {
+    for (int s : sizes) mutable_parameter_block_sizes()->push_back(s);
+    set_num_residuals(rows);
+  }
+  bool Evaluate(double const* const* x, double* r, double** jac) const override {
+    const std::vector<int> sizes(parameter_block_sizes().begin(), parameter_block_sizes().end());
+    std::vector<const double*> ptrs(x, x + sizes.size());
+    Eigen::Map<Eigen::VectorXd>(r, num_residuals()) = f_(ptrs);
+    if (jac) tangentNumericJacobians(f_, sizes, x, num_residuals(), jac);
+    return true;
+  }
+
+ private:
+  ResidualFn f_;
+};
+
+using Pose = std::array<double, 7>;
+
+Pose makePose(const Eigen::Vector3d& p, const Eigen::Matrix3d& R) {
+  const Eigen::Quaterniond q(R);
+  return {p.x(), p.y(), p.z(), q.x(), q.y(), q.z(), q.w()};
+}
+Eigen::Vector3d posOf(const double* x) { return Eigen::Map<const Eigen::Vector3d>(x); }
+Eigen::Matrix3d rotOf(const double* x) {
+  return Eigen::Map<const Eigen::Quaterniond>(x + 3).normalized().toRotationMatrix();
+}
+
+/// Pose prior: W [p - p_m; Log(R_m^T R)].
+std::shared_ptr<ceres::CostFunction> posePrior(const Pose& measured, double weight) {
+  return std::make_shared<NumericTangentCost>(
+      [measured, weight](const std::vector<const double*>& x) {
+        Eigen::VectorXd r(6);
+        r.head<3>() = posOf(x[0]) - posOf(measured.data());
+        r.tail<3>() = so3::log(rotOf(measured.data()).transpose() * rotOf(x[0]));
+        return Eigen::VectorXd(weight * r);
+      },
+      std::vector<int>{7}, 6);
+}
+
+/// Relative pose: W [R_i^T (p_j - p_i) - dp_m; Log(dR_m^T R_i^T R_j)].
+std::shared_ptr<ceres::CostFunction> relativePose(const Eigen::Vector3d& dp, const Eigen::Matrix3d& dR, double weight) {
+  return std::make_shared<NumericTangentCost>(
+      [dp, dR, weight](const std::vector<const double*>& x) {
+        const Eigen::Matrix3d Ri = rotOf(x[0]);
+        Eigen::VectorXd r(6);
+        r.head<3>() = Ri.transpose() * (posOf(x[1]) - posOf(x[0])) - dp;
+        r.tail<3>() = so3::log(dR.transpose() * Ri.transpose() * rotOf(x[1]));
+        return Eigen::VectorXd(weight * r);
+      },
+      std::vector<int>{7, 7}, 6);
+}
+
+/// A factor of a test problem: cost (+ loss) over blocks given by index.
+struct TestFactor {
+  std::shared_ptr<ceres::CostFunction> cost;
+  std::vector<int> blocks;
+  std::shared_ptr<ceres::LossFunction> loss;
+};
+
+/// Marginalises `dropped` (block indices): every factor touching one goes into the info.
+std::shared_ptr<MarginalizationInfo> marginalizeBlocks(const std::vector<TestFactor>& factors,
+                                                       const std::vector<double*>& blocks,
+                                                       const std::set<int>& dropped) {
+  auto info = std::make_shared<MarginalizationInfo>();
+  for (const TestFactor& f : factors) {
+    ResidualBlockInfo res;
+    res.cost = f.cost;
+    res.loss = f.loss;
+    for (size_t k = 0; k < f.blocks.size(); ++k) {
+      res.blocks.push_back(blocks[f.blocks[k]]);
+      if (dropped.count(f.blocks[k])) res.drop.push_back(static_cast<int>(k));
+    }
+    if (!res.drop.empty()) info->add(std::move(res));
+  }
+  info->linearize();
+  info->marginalize();
+  return info;
+}
+
+/// Adds the factors touching none of `dropped` to `problem`.
+void addRemainingFactors(ceres::Problem& problem, const std::vector<TestFactor>& factors,
+                         const std::vector<double*>& blocks, const std::set<int>& dropped) {
+  for (const TestFactor& f : factors) {
+    bool touches = false;
+    std::vector<double*> ptrs;
+    for (int b : f.blocks) {
+      touches |= dropped.count(b) > 0;
+      ptrs.push_back(blocks[b]);
+    }
+    // The problem does not own the test's shared costs.
+    if (!touches) problem.AddResidualBlock(f.cost.get(), f.loss.get(), ptrs);
+  }
+}
+
+ceres::Problem::Options nonOwningOptions() {
+  ceres::Problem::Options o;
+  o.cost_function_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
+  o.loss_function_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
+  o.manifold_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
+  return o;
+}
+
+ceres::Solver::Options tightSolverOptions() {
+  ceres::Solver::Options o;
+  o.linear_solver_type = ceres::DENSE_QR;
+  o.max_num_iterations = 100;
+  o.function_tolerance = 1e-20;
+  o.gradient_tolerance = 1e-20;
+  o.parameter_tolerance = 1e-20;
+  o.initial_trust_region_radius = 1e8;
+  return o;
+}
+
+/// Dense Jacobian of `problem` over `blocks` (tangent columns) at the current values.
+Eigen::MatrixXd denseJacobian(ceres::Problem& problem, const std::vector<double*>& blocks) {
+  ceres::Problem::EvaluateOptions eo;
+  eo.parameter_blocks = blocks;
+  ceres::CRSMatrix crs;
+  problem.Evaluate(eo, nullptr, nullptr, nullptr, &crs);
+  Eigen::MatrixXd j = Eigen::MatrixXd::Zero(crs.num_rows, crs.num_cols);
+  for (int row = 0; row < crs.num_rows; ++row)
+    for (int k = crs.rows[row]; k < crs.rows[row + 1]; ++k) j(row, crs.cols[k]) = crs.values[k];
+  return j;
+}
+
+/// Linear chain x0..x4 (size 3): prior on x0 and x4, odometry x_i -> x_{i+1}, loops x0-x2 and x1-x3.
+std::vector<TestFactor> linearChain(std::mt19937& rng) {
+  auto sqrtInfo = [&rng] { return Eigen::MatrixXd(2.0 * Eigen::MatrixXd::Identity(3, 3) + randomMatrix(3, 3, rng, 0.5)); };
+  auto link = [&](int i, int j) {
+    const Eigen::MatrixXd a = sqrtInfo();
+    return TestFactor{std::make_shared<LinearFactor>(std::vector<Eigen::MatrixXd>{-a, a},
+                                                     Eigen::VectorXd(randomMatrix(3, 1, rng))),
+                      {i, j}, nullptr};
+  };
+  std::vector<TestFactor> f;
+  f.push_back({std::make_shared<LinearFactor>(std::vector<Eigen::MatrixXd>{sqrtInfo()}, Eigen::VectorXd(randomMatrix(3, 1, rng))), {0}, nullptr});
+  for (int i = 0; i < 4; ++i) f.push_back(link(i, i + 1));
+  f.push_back(link(0, 2));
+  f.push_back(link(1, 3));
+  f.push_back({std::make_shared<LinearFactor>(std::vector<Eigen::MatrixXd>{sqrtInfo()}, Eigen::VectorXd(randomMatrix(3, 1, rng))), {4}, nullptr});
+  return f;
+}
+
+}  // namespace
+
+TEST_CASE("Marginalising a linear-Gaussian chain keeps the exact solution and marginal covariance",
+          "[estimator][marginalization]") {
+  std::mt19937 rng(7);
+  const std::vector<TestFactor> factors = linearChain(rng);
+  constexpr int kBlocks = 5;
+
+  // Full problem densely: r(x) = J x - c stacked, x* = (J^T J)^-1 J^T c, covariance (J^T J)^-1.
+  int rows = 0;
+  for (const auto& f : factors) rows += f.cost->num_residuals();
+  Eigen::MatrixXd J = Eigen::MatrixXd::Zero(rows, 3 * kBlocks);
+  Eigen::VectorXd c(rows);
+  int row = 0;
+  for (const auto& f : factors) {
+    const auto& lin = static_cast<const LinearFactor&>(*f.cost);
+    for (size_t k = 0; k < f.blocks.size(); ++k) J.block(row, 3 * f.blocks[k], 3, 3) = lin.a()[k];
+    c.segment(row, 3) = lin.c();
+    row += 3;
+  }
+  const Eigen::MatrixXd H = J.transpose() * J;
+  const Eigen::VectorXd x_star = H.ldlt().solve(J.transpose() * c);
+  const Eigen::MatrixXd covariance = H.inverse();
+
+  for (const std::set<int>& dropped : {std::set<int>{0}, std::set<int>{0, 1}}) {
+    const int first_kept = static_cast<int>(dropped.size());
+    std::vector<std::array<double, 3>> x(kBlocks);
+    std::vector<double*> blocks;
+    for (auto& xi : x) {
+      const Eigen::Vector3d v = randomMatrix(3, 1, rng, 2.0);  // arbitrary linearisation point
+      xi = {v.x(), v.y(), v.z()};
+      blocks.push_back(xi.data());
+    }
+    const auto info = marginalizeBlocks(factors, blocks, dropped);
+    REQUIRE(info->keptTangentSize() == 6);  // x1,x2 (or x2,x3) share a factor with the dropped blocks
+
+    ceres::Problem problem(nonOwningOptions());
+    MarginalizationFactor prior(info);
+    problem.AddResidualBlock(&prior, nullptr, info->keptBlocks());
+    addRemainingFactors(problem, factors, blocks, dropped);
+    for (int i = first_kept; i < kBlocks; ++i) x[i] = {0.0, 0.0, 0.0};  // start away from the optimum
+    ceres::Solver::Summary summary;
+    ceres::Solve(tightSolverOptions(), &problem, &summary);
+
+    const std::vector<double*> kept(blocks.begin() + first_kept, blocks.end());
+    for (int i = first_kept; i < kBlocks; ++i) {
+      INFO("dropped " << dropped.size() << " block(s), block " << i);
+      CHECK((Eigen::Map<const Eigen::Vector3d>(x[i].data()) - x_star.segment<3>(3 * i)).cwiseAbs().maxCoeff() < 1e-8);
+    }
+    const Eigen::MatrixXd Jr = denseJacobian(problem, kept);
+    const Eigen::MatrixXd reduced_cov = (Jr.transpose() * Jr).inverse();
+    const int n = 3 * (kBlocks - first_kept);
+    const Eigen::MatrixXd full_cov = covariance.bottomRightCorner(n, n);
+    INFO("dropped " << dropped.size() << " block(s)");
+    CHECK((reduced_cov - full_cov).cwiseAbs().maxCoeff() < 1e-8);
+  }
+}
+
+TEST_CASE("Marginalising the first pose at the optimum keeps the pose graph's optimum",
+          "[estimator][marginalization]") {
+  std::mt19937 rng(11);
+  std::normal_distribution<double> noise(0.0, 0.05);
+  auto noisy3 = [&] { return Eigen::Vector3d(noise(rng), noise(rng), noise(rng)); };
+  constexpr int kPoses = 4;
+  std::vector<Eigen::Vector3d> p_true;
+  std::vector<Eigen::Matrix3d> R_true;
+  for (int i = 0; i < kPoses; ++i) {
+    p_true.emplace_back(1.0 * i, 0.3 * std::sin(i), 0.1 * i * i);
+    R_true.push_back(so3::fromYawPitchRoll(0.4 * i, 0.1 * i, -0.05 * i));
+  }
+  // Noisy measurements, so the optimum fits none of them exactly.
+  std::vector<TestFactor> factors;
+  factors.push_back({posePrior(makePose(p_true[0] + noisy3(), R_true[0] * so3::exp(noisy3())), 10.0), {0}, nullptr});
+  for (auto [i, j] : std::vector<std::pair<int, int>>{{0, 1}, {1, 2}, {2, 3}, {0, 2}, {1, 3}}) {
+    const Eigen::Vector3d dp = R_true[i].transpose() * (p_true[j] - p_true[i]) + noisy3();
+    const Eigen::Matrix3d dR = R_true[i].transpose() * R_true[j] * so3::exp(noisy3());
+    factors.push_back({relativePose(dp, dR, 3.0), {i, j}, nullptr});
+  }
+
+  std::vector<Pose> x(kPoses);
+  std::vector<double*> blocks;
+  for (int i = 0; i < kPoses; ++i) {
+    x[i] = makePose(p_true[i] + 3 * noisy3(), R_true[i] * so3::exp(3 * noisy3()));
+    blocks.push_back(x[i].data());
+  }
+  PoseManifold manifold;
+  {
+    ceres::Problem full(nonOwningOptions());
+    addRemainingFactors(full, factors, blocks, {});
+    for (double* b : blocks) full.SetManifold(b, &manifold);
+    ceres::Solver::Summary summary;
+    ceres::Solve(tightSolverOptions(), &full, &summary);
+    REQUIRE(summary.IsSolutionUsable());
+  }
+  const std::vector<Pose> optimum = x;
+
+  const auto info = marginalizeBlocks(factors, blocks, {0});
+  REQUIRE(info->keptBlocks() == std::vector<double*>{blocks[1], blocks[2]});
+
+  ceres::Problem reduced(nonOwningOptions());
+  MarginalizationFactor prior(info);
+  reduced.AddResidualBlock(&prior, nullptr, info->keptBlocks());
+  addRemainingFactors(reduced, factors, blocks, {0});
+  for (int i = 1; i < kPoses; ++i) {
+    x[i] = makePose(posOf(x[i].data()) + Eigen::Vector3d(0.2, -0.1, 0.15), rotOf(x[i].data()) * so3::exp(Eigen::Vector3d(0.1, -0.08, 0.12)));
+    reduced.SetManifold(x[i].data(), &manifold);
+  }
+  ceres::Solver::Summary summary;
+  ceres::Solve(tightSolverOptions(), &reduced, &summary);
+  for (int i = 1; i < kPoses; ++i) {
+    INFO("pose " << i);
+    CHECK((posOf(x[i].data()) - posOf(optimum[i].data())).norm() < 1e-6);
+    CHECK(so3::log(rotOf(optimum[i].data()).transpose() * rotOf(x[i].data())).norm() < 1e-6);
+  }
+}
+
+TEST_CASE("MarginalizationFactor Jacobians match numeric differentiation through PoseManifold::Plus",
+          "[estimator][marginalization]") {
+  std::mt19937 rng(3);
+  // Pose 0 tied to pose 1, a 9-dim speed-bias-like block and pose 2; marginalise pose 0.
+  Pose t0 = makePose({0, 0, 0}, Eigen::Matrix3d::Identity());
+  Pose t1 = makePose({1, 0.2, -0.1}, so3::exp({0.1, 0.3, -0.2}));
+  Pose t2 = makePose({2, 0.1, 0.3}, so3::exp({-0.2, 0.6, 0.1}));
+  std::array<double, 9> sb{};
+  for (double& v : sb) v = std::uniform_real_distribution<double>(-1, 1)(rng);
+  auto sb_factor = std::make_shared<NumericTangentCost>(
+      [](const std::vector<const double*>& x) {
+        Eigen::VectorXd r(9);
+        r.head<3>() = rotOf(x[0]).transpose() * Eigen::Map<const Eigen::Vector3d>(x[1]) - Eigen::Vector3d(1, 0, 0);
+        r.tail<6>() = 2.0 * Eigen::Map<const Eigen::Matrix<double, 6, 1>>(x[1] + 3);
+        return r;
+      },
+      std::vector<int>{7, 9}, 9);
+  const std::vector<TestFactor> factors{
+      {posePrior(makePose({0.1, 0, 0}, so3::exp({0, 0, 0.1})), 5.0), {0}, nullptr},
+      {relativePose({1, 0, 0}, so3::exp({0.1, 0.2, -0.3}), 2.0), {0, 1}, nullptr},
+      {sb_factor, {0, 2}, nullptr},
+      {relativePose({2, 0, 0}, so3::exp({-0.1, 0.5, 0.2}), 2.0), {0, 3}, nullptr},
+  };
+  const std::vector<double*> blocks{t0.data(), t1.data(), sb.data(), t2.data()};
+  const auto info = marginalizeBlocks(factors, blocks, {0});
+  MarginalizationFactor prior(info);
+  REQUIRE(prior.parameter_block_sizes() == std::vector<int32_t>{7, 9, 7});
+  const int rows = prior.num_residuals();
+  REQUIRE(rows == info->keptTangentSize());  // t1 (6) + sb (9) + t2 (6), full rank
+
+  // At the linearisation point the residual is r0.
+  {
+    Eigen::VectorXd r(rows);
+    const double* params[] = {t1.data(), sb.data(), t2.data()};
+    prior.Evaluate(params, r.data(), nullptr);
+    CHECK((r - info->linearizedResidual()).cwiseAbs().maxCoeff() < 1e-12);
+  }
+
+  // Far from it (rotations moved ~0.5 rad), analytic vs numeric.
+  const PoseManifold manifold;
+  Pose t1m, t2m;
+  const Eigen::Matrix<double, 6, 1> d1 = (Eigen::Matrix<double, 6, 1>() << 0.3, -0.2, 0.1, 0.4, -0.3, 0.2).finished();
+  const Eigen::Matrix<double, 6, 1> d2 = (Eigen::Matrix<double, 6, 1>() << -0.1, 0.5, 0.2, -0.2, 0.35, -0.4).finished();
+  manifold.Plus(t1.data(), d1.data(), t1m.data());
+  manifold.Plus(t2.data(), d2.data(), t2m.data());
+  std::array<double, 9> sbm = sb;
+  for (double& v : sbm) v += 0.3;
+  const double* params[] = {t1m.data(), sbm.data(), t2m.data()};
+  const std::vector<int> sizes{7, 9, 7};
+  std::vector<RowMajor> analytic, numeric;
+  std::vector<double*> ja, jn;
+  for (int s : sizes) {
+    analytic.emplace_back(RowMajor::Constant(rows, s, 99.0));
+    numeric.emplace_back(RowMajor::Zero(rows, s));
+    ja.push_back(analytic.back().data());
+    jn.push_back(numeric.back().data());
+  }
+  Eigen::VectorXd r(rows);
+  REQUIRE(prior.Evaluate(params, r.data(), ja.data()));
+  const ResidualFn f = [&prior, rows](const std::vector<const double*>& x) {
+    Eigen::VectorXd out(rows);
+    prior.Evaluate(x.data(), out.data(), nullptr);
+    return out;
+  };
+  tangentNumericJacobians(f, sizes, params, rows, jn.data());
+  for (size_t i = 0; i < sizes.size(); ++i) {
+    INFO("block " << i);
+    CHECK((analytic[i] - numeric[i]).cwiseAbs().maxCoeff() < 1e-6);
+    if (sizes[i] == 7) CHECK(analytic[i].col(6).isZero(0.0));
+  }
+  // The identity approximation of d Log / dθ would be off by far more than the tolerance here.
+  CHECK((analytic[0].middleCols<3>(3) - info->linearizedJacobian().middleCols<3>(3)).cwiseAbs().maxCoeff() > 1e-3);
+}
+
+TEST_CASE("Dropping a block that shares no factor with the kept ones leaves the prior unchanged",
+          "[estimator][marginalization]") {
+  std::mt19937 rng(5);
+  const std::vector<TestFactor> chain = linearChain(rng);
+  std::vector<std::array<double, 3>> x(6, std::array<double, 3>{0.3, -0.2, 0.5});
+  std::vector<double*> blocks;
+  for (auto& xi : x) blocks.push_back(xi.data());
+  std::vector<TestFactor> with_isolated = chain;
+  with_isolated.push_back({std::make_shared<LinearFactor>(std::vector<Eigen::MatrixXd>{Eigen::MatrixXd::Identity(3, 3)},
+                                                          Eigen::VectorXd::Ones(3)),
+                           {5}, nullptr});
+  const auto plain = marginalizeBlocks(chain, blocks, {0});
+  const auto isolated = marginalizeBlocks(with_isolated, blocks, {0, 5});
+  REQUIRE(isolated->keptBlocks() == plain->keptBlocks());
+  const Eigen::MatrixXd& J1 = plain->linearizedJacobian();
+  const Eigen::MatrixXd& J2 = isolated->linearizedJacobian();
+  CHECK((J1.transpose() * J1 - J2.transpose() * J2).cwiseAbs().maxCoeff() < 1e-10);
+  CHECK((J1.transpose() * plain->linearizedResidual() - J2.transpose() * isolated->linearizedResidual())
+            .cwiseAbs().maxCoeff() < 1e-10);
+}
+
+TEST_CASE("A Huber loss on a marginalised factor weights its information by rho'",
+          "[estimator][marginalization]") {
+  // x (dropped) and y (kept); r_A = x - y, r_B = x - m under Huber(a). With rho' = rho'(r_B^2):
+  //   H = [1+rho' -1; -1 1], b = [r_A + rho' r_B; -r_A]  ->  H* = rho'/(1+rho'), b* = rho'(r_B - r_A)/(1+rho').
+  const double m = 0.0;
+  double x = 2.0, y = 1.5;
+  const double r_a = x - y, r_b = x - m;
+  for (const double a : {0.5, 5.0}) {
+    const double rho1 = std::abs(r_b) > a ? a / std::abs(r_b) : 1.0;  // Huber: rho'(s) = a / sqrt(s) past a^2
+    const std::vector<TestFactor> factors{
+        {std::make_shared<LinearFactor>(std::vector<Eigen::MatrixXd>{Eigen::MatrixXd::Ones(1, 1), -Eigen::MatrixXd::Ones(1, 1)},
+                                        Eigen::VectorXd::Zero(1)),
+         {0, 1}, nullptr},
+        {std::make_shared<LinearFactor>(std::vector<Eigen::MatrixXd>{Eigen::MatrixXd::Ones(1, 1)}, Eigen::VectorXd::Constant(1, m)),
+         {0}, std::make_shared<ceres::HuberLoss>(a)},
+    };
+    const auto info = marginalizeBlocks(factors, {&x, &y}, {0});
+    const Eigen::MatrixXd& J = info->linearizedJacobian();
+    INFO("Huber a = " << a << ", rho' = " << rho1);
+    REQUIRE(J.rows() == 1);
+    CHECK((J.transpose() * J)(0, 0) == Approx(rho1 / (1.0 + rho1)).epsilon(1e-12));
+    CHECK((J.transpose() * info->linearizedResidual())(0) == Approx(rho1 * (r_b - r_a) / (1.0 + rho1)).epsilon(1e-12));
+  }
+}
+
+/// rho(s) = s + s^2 / 4: rho'' > 0, so Ceres applies the second-order Corrector branch.
+class StiffeningLoss final : public ceres::LossFunction {
+ public:
+  void Evaluate(double s, double rho[3]) const override {
+    rho[0] = s + 0.25 * s * s;
+    rho[1] = 1.0 + 0.5 * s;
+    rho[2] = 0.5;
+  }
+};
+
+TEST_CASE("Robust losses enter the prior exactly as Ceres' own Gauss-Newton system has them",
+          "[estimator][marginalization]") {
+  // x (size 2, dropped), y (size 2, kept); Huber on one factor, a rho'' > 0 loss on another. Ceres'
+  // Problem::Evaluate returns the loss-corrected Jacobian and gradient; their Schur complement onto y
+  // must equal the prior's J^T J and J^T r0.
+  std::mt19937 rng(19);
+  std::array<double, 2> x{1.5, -0.7}, y{0.4, 0.9};
+  auto linear = [&rng](int blocks) {
+    std::vector<Eigen::MatrixXd> a;
+    for (int k = 0; k < blocks; ++k) a.push_back(randomMatrix(2, 2, rng) + (k == 0 ? 2.0 : -1.0) * Eigen::MatrixXd::Identity(2, 2));
+    return std::make_shared<LinearFactor>(a, Eigen::VectorXd(randomMatrix(2, 1, rng)));
+  };
+  const std::vector<TestFactor> factors{
+      {linear(2), {0, 1}, std::make_shared<StiffeningLoss>()},
+      {linear(1), {0}, std::make_shared<ceres::HuberLoss>(0.3)},
+      {linear(2), {1, 0}, nullptr},
+  };
+  const std::vector<double*> blocks{x.data(), y.data()};
+
+  ceres::Problem problem(nonOwningOptions());
+  addRemainingFactors(problem, factors, blocks, {});
+  const Eigen::MatrixXd J = denseJacobian(problem, blocks);
+  std::vector<double> gradient;
+  ceres::Problem::EvaluateOptions eo;
+  eo.parameter_blocks = blocks;
+  problem.Evaluate(eo, nullptr, nullptr, &gradient, nullptr);
+  const Eigen::MatrixXd H = J.transpose() * J;
+  const Eigen::VectorXd b = Eigen::Map<const Eigen::VectorXd>(gradient.data(), 4);
+  const Eigen::Matrix2d h_star = H.bottomRightCorner<2, 2>() - H.bottomLeftCorner<2, 2>() * H.topLeftCorner<2, 2>().inverse() * H.topRightCorner<2, 2>();
+  const Eigen::Vector2d b_star = b.tail<2>() - H.bottomLeftCorner<2, 2>() * H.topLeftCorner<2, 2>().inverse() * b.head<2>();
+
+  const auto info = marginalizeBlocks(factors, blocks, {0});
+  const Eigen::MatrixXd& Jm = info->linearizedJacobian();
+  CHECK((Jm.transpose() * Jm - h_star).cwiseAbs().maxCoeff() < 1e-10);
+  CHECK((Jm.transpose() * info->linearizedResidual() - b_star).cwiseAbs().maxCoeff() < 1e-10);
+  // Both losses are really active here (else this test would not exercise the corrections).
+  double rho[3];
+  Eigen::VectorXd r(2);
+  const double* px[] = {x.data(), y.data()};
+  factors[0].cost->Evaluate(px, r.data(), nullptr);
+  StiffeningLoss().Evaluate(r.squaredNorm(), rho);
+  CHECK(rho[1] > 1.2);
+  factors[1].cost->Evaluate(px, r.data(), nullptr);
+  CHECK(r.norm() > 0.3);
+}
+
+TEST_CASE("keptBlocks follows the linearized column order and applies the address shift",
+          "[estimator][marginalization]") {
+  // Kept blocks of sizes 3, 1, 2 with priors of distinct weights, plus a dropped block d linked to a.
+  std::array<double, 3> c{1, 2, 3};
+  std::array<double, 1> a{0.5};
+  std::array<double, 2> b{-1, 1};
+  std::array<double, 2> d{0.2, 0.4};
+  auto prior = [](int size, double w) {
+    return std::make_shared<LinearFactor>(std::vector<Eigen::MatrixXd>{w * Eigen::MatrixXd::Identity(size, size)},
+                                          Eigen::VectorXd::Zero(size));
+  };
+  const std::vector<TestFactor> factors{
+      {prior(3, 3.0), {0}, nullptr},
+      {prior(1, 1.0), {1}, nullptr},
+      {std::make_shared<LinearFactor>(std::vector<Eigen::MatrixXd>{Eigen::MatrixXd::Ones(1, 2), Eigen::MatrixXd::Ones(1, 1)},
+                                      Eigen::VectorXd::Zero(1)),
+       {3, 1}, nullptr},
+      {prior(2, 1.0), {3}, nullptr},
+      {prior(2, 2.0), {2}, nullptr},
+  };
+  // Every prior is added with a dropped block so that all blocks enter the info.
+  MarginalizationInfo info;
+  const std::vector<double*> blocks{c.data(), a.data(), b.data(), d.data()};
+  for (const TestFactor& f : factors) {
+    ResidualBlockInfo res{f.cost, f.loss, {}, {}};
+    for (int k : f.blocks) res.blocks.push_back(blocks[k]);
+    if (f.blocks.front() == 3) res.drop = {0};
+    info.add(res);
+  }
+  info.linearize();
+  info.marginalize();
+
+  REQUIRE(info.keptBlocks() == std::vector<double*>{c.data(), a.data(), b.data()});
+  REQUIRE(info.keptSizes() == std::vector<int>{3, 1, 2});
+  REQUIRE(info.keptTangentOffsets() == std::vector<int>{0, 3, 4});
+  // The diagonal of J^T J identifies each block: c -> 9, b -> 4, a -> prior 1 + link 1 minus the Schur
+  // term of d (H_dd = I + 1 1^T, H_da = 1: 1^T H_dd^-1 1 = 2/3).
+  const Eigen::MatrixXd H = info.linearizedJacobian().transpose() * info.linearizedJacobian();
+  CHECK((H.diagonal() - (Eigen::VectorXd(6) << 9, 9, 9, 1.0 + 1.0 - 2.0 / 3.0, 4, 4).finished()).cwiseAbs().maxCoeff() < 1e-12);
+
+  std::array<double, 3> c_new{};
+  std::array<double, 2> b_new{};
+  const std::unordered_map<const double*, double*> shift{{c.data(), c_new.data()}, {b.data(), b_new.data()}};
+  CHECK(info.keptBlocks(shift) == std::vector<double*>{c_new.data(), a.data(), b_new.data()});
+}
+
+TEST_CASE("Marginalising every block throws", "[estimator][marginalization]") {
+  std::array<double, 2> x{1, 2};
+  MarginalizationInfo info;
+  info.add({std::make_shared<LinearFactor>(std::vector<Eigen::MatrixXd>{Eigen::MatrixXd::Identity(2, 2)}, Eigen::VectorXd::Zero(2)),
+            nullptr, {x.data()}, {0}});
+  info.linearize();
+  CHECK_THROWS_AS(info.marginalize(), std::runtime_error);
+  CHECK_THROWS_AS(info.add({nullptr, nullptr, {x.data()}, {}}), std::logic_error);
+}
