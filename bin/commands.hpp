@@ -24,5 +24,6 @@ void add_eval_command(CLI::App& app);
 void add_convert_command(CLI::App& app);
 void add_replay_command(CLI::App& app);
 void add_sim_command(CLI::App& app);
+void add_run_command(CLI::App& app);
 
 }  // namespace dynavins::cli

@@ -28,6 +28,7 @@ int main(int argc, char** argv) {
   dynavins::cli::add_convert_command(app);
   dynavins::cli::add_replay_command(app);
   dynavins::cli::add_eval_command(app);
+  dynavins::cli::add_run_command(app);
 
   try {
     app.parse(argc, argv);

@@ -1,6 +1,9 @@
 #include "stages/common/estimator_options.hpp"
 
+#include <cmath>
+#include <functional>
 #include <iomanip>
+#include <map>
 #include <sstream>
 
 #include <spdlog/spdlog.h>
@@ -114,7 +117,8 @@ std::string EstimatorOptions::print() const {
   s << std::setprecision(10) << std::boolalpha;
   auto line = [&](const std::string& key, const auto& value, const char* note = "") {
     s << "  " << std::left << std::setw(22) << key << " = " << value << "  ("
-      << (keys_from_file.count(key) ? "file" : "default") << ")" << note << "\n";
+      << (keys_from_override.count(key) ? "--set" : keys_from_file.count(key) ? "file" : "default") << ")" << note
+      << "\n";
   };
   s << "Estimator options from " << config_file << ":\n";
   line("imu", use_imu);
@@ -160,6 +164,136 @@ std::string EstimatorOptions::print() const {
   line("alternating_converge", alternating_converge);
   line("margin_feature_thresh", margin_feature_thresh);
   return s.str();
+}
+
+namespace {
+
+constexpr const char* kOverrideSource = "--set";
+
+std::string trim(const std::string& s) {
+  const auto b = s.find_first_not_of(" \t"), e = s.find_last_not_of(" \t");
+  return b == std::string::npos ? std::string() : s.substr(b, e - b + 1);
+}
+
+[[noreturn]] void bad(const std::string& key, const std::string& problem) {
+  throw ConfigError(kOverrideSource, key, problem);
+}
+
+double parse_double(const std::string& key, const std::string& v) {
+  std::size_t used = 0;
+  double x = 0;
+  try {
+    x = std::stod(v, &used);
+  } catch (const std::exception&) {
+    used = 0;
+  }
+  if (used == 0 || used != v.size() || !std::isfinite(x)) bad(key, "expected a number, got '" + v + "'");
+  return x;
+}
+
+int parse_int(const std::string& key, const std::string& v) {
+  std::size_t used = 0;
+  long x = 0;
+  try {
+    x = std::stol(v, &used);
+  } catch (const std::exception&) {
+    used = 0;
+  }
+  if (used == 0 || used != v.size() || x < INT32_MIN || x > INT32_MAX) bad(key, "expected an integer, got '" + v + "'");
+  return static_cast<int>(x);
+}
+
+bool parse_bool(const std::string& key, const std::string& v) {
+  if (v == "true" || v == "1") return true;
+  if (v == "false" || v == "0") return false;
+  bad(key, "expected true/false/1/0, got '" + v + "'");
+}
+
+}  // namespace
+
+std::pair<std::string, std::string> EstimatorOptions::parseOverride(const std::string& text) {
+  const auto eq = text.find('=');
+  if (eq == std::string::npos) bad("", "expected key=value, got '" + text + "'");
+  std::pair<std::string, std::string> kv{trim(text.substr(0, eq)), trim(text.substr(eq + 1))};
+  if (kv.first.empty()) bad("", "empty key in '" + text + "'");
+  if (kv.second.empty()) bad(kv.first, "empty value in '" + text + "'");
+  return kv;
+}
+
+void EstimatorOptions::apply(const std::string& key, const std::string& value) {
+  // Each scalar key: how to parse it and which values the file loader would accept.
+  using Setter = std::function<void(EstimatorOptions&, const std::string&, const std::string&)>;
+  auto positive_int = [](int EstimatorOptions::*m) -> Setter {
+    return [m](EstimatorOptions& o, const std::string& k, const std::string& v) {
+      const int x = parse_int(k, v);
+      if (x <= 0) bad(k, "must be positive");
+      o.*m = x;
+    };
+  };
+  auto real_in = [](double EstimatorOptions::*m, double lo, double hi, bool lo_open, const char* what) -> Setter {
+    return [=](EstimatorOptions& o, const std::string& k, const std::string& v) {
+      const double x = parse_double(k, v);
+      if (x < lo || x > hi || (lo_open && x == lo)) bad(k, what);
+      o.*m = x;
+    };
+  };
+  auto flag = [](bool EstimatorOptions::*m) -> Setter {
+    return [m](EstimatorOptions& o, const std::string& k, const std::string& v) { o.*m = parse_bool(k, v); };
+  };
+  const double inf = HUGE_VAL;
+  static const std::set<std::string> fixed{"imu", "num_of_cam", "image_width", "image_height", "cam0_calib",
+                                           "cam1_calib", "body_T_cam0", "body_T_cam1"};
+  const std::map<std::string, Setter> setters{
+      {"estimate_extrinsic",
+       [](EstimatorOptions& o, const std::string& k, const std::string& v) {
+         const int x = parse_int(k, v);
+         if (x < 0 || x > 2) bad(k, "must be 0, 1 or 2");
+         o.estimate_extrinsic = x;
+       }},
+      {"max_cnt", positive_int(&EstimatorOptions::max_cnt)},
+      {"min_dist", real_in(&EstimatorOptions::min_dist, 0, inf, false, "must be non-negative")},
+      {"freq", real_in(&EstimatorOptions::freq, 0, inf, false, "must be non-negative")},
+      {"F_threshold", real_in(&EstimatorOptions::F_threshold, 0, inf, true, "must be positive")},
+      {"show_track", flag(&EstimatorOptions::show_track)},
+      {"flow_back", flag(&EstimatorOptions::flow_back)},
+      {"max_solver_time", real_in(&EstimatorOptions::max_solver_time, 0, inf, true, "must be positive [s]")},
+      {"max_num_iterations", positive_int(&EstimatorOptions::max_num_iterations)},
+      {"keyframe_parallax", real_in(&EstimatorOptions::keyframe_parallax, 0, inf, true, "must be positive")},
+      {"window_size", positive_int(&EstimatorOptions::window_size)},
+      {"acc_n", real_in(&EstimatorOptions::acc_n, 0, inf, true, "must be positive")},
+      {"gyr_n", real_in(&EstimatorOptions::gyr_n, 0, inf, true, "must be positive")},
+      {"acc_w", real_in(&EstimatorOptions::acc_w, 0, inf, true, "must be positive")},
+      {"gyr_w", real_in(&EstimatorOptions::gyr_w, 0, inf, true, "must be positive")},
+      {"g_norm", real_in(&EstimatorOptions::g_norm, 0, inf, true, "must be positive")},
+      {"estimate_td", flag(&EstimatorOptions::estimate_td)},
+      {"td", real_in(&EstimatorOptions::td, -inf, inf, false, "")},
+      {"dyna_on", flag(&EstimatorOptions::dyna_on)},
+      {"regularization_lambda",
+       [](EstimatorOptions& o, const std::string& k, const std::string& v) {
+         const double x = parse_double(k, v);
+         if (x < 0) bad(k, "must be non-negative");
+         o.regularization_gamma = x;
+         o.lambda_w = x * x;
+       }},
+      {"momentum_on", flag(&EstimatorOptions::momentum_on)},
+      {"momentum_lambda", real_in(&EstimatorOptions::lambda_m, 0, inf, false, "must be non-negative")},
+      {"alternating_converge", real_in(&EstimatorOptions::alternating_converge, 0, 1, true,
+                                       "must be in (0, 1] (fraction of converged weights)")},
+      {"margin_feature_thresh",
+       real_in(&EstimatorOptions::margin_feature_thresh, 0, 1, false, "must be in [0, 1]")},
+  };
+  if (fixed.count(key)) bad(key, "describes the sensor rig and cannot be overridden; edit the yaml");
+  const auto it = setters.find(key);
+  if (it == setters.end()) bad(key, "unknown option (see the option list printed at start)");
+  it->second(*this, key, value);
+  keys_from_override.insert(key);
+}
+
+EstimatorOptions EstimatorOptions::load(const std::string& path,
+                                        const std::vector<std::pair<std::string, std::string>>& overrides) {
+  EstimatorOptions o = load(path);
+  for (const auto& [key, value] : overrides) o.apply(key, value);
+  return o;
 }
 
 }  // namespace dynavins

@@ -14,6 +14,7 @@
 
 #include <set>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include <Eigen/Geometry>
@@ -62,11 +63,21 @@ struct EstimatorOptions {
   double alternating_converge = 0.9;
   double margin_feature_thresh = 0.1;
 
-  std::set<std::string> keys_from_file;  ///< which options the file set (the rest are defaults)
+  std::set<std::string> keys_from_file;      ///< which options the file set (the rest are defaults)
+  std::set<std::string> keys_from_override;  ///< which options a command line `--set key=value` set
 
   /// Loads `path`; throws ConfigError naming key and file on missing or wrongly typed keys.
   static EstimatorOptions load(const std::string& path);
-  /// Every effective option, one per line, with "(file)" or "(default)".
+  /// Loads `path`, then applies `overrides` (key, value) in order, as `--set key=value` does.
+  static EstimatorOptions load(const std::string& path,
+                               const std::vector<std::pair<std::string, std::string>>& overrides);
+  /// Sets one scalar option from text (numbers, true/false/1/0), checked like the file's value.
+  /// Throws ConfigError with file "--set" naming the key for an unknown key, a key that cannot be
+  /// overridden (cameras, image size), or a bad value.
+  void apply(const std::string& key, const std::string& value);
+  /// Splits "key=value" (both non-empty, whitespace trimmed); throws ConfigError("--set", ...) otherwise.
+  static std::pair<std::string, std::string> parseOverride(const std::string& text);
+  /// Every effective option, one per line, with "(file)", "(--set)" or "(default)".
   std::string print() const;
 };
 

@@ -286,6 +286,18 @@ void SlidingWindowEstimator::Impl::fillOutput(WindowEstimate& e) {
     wf.v = static_cast<float>(f.obs.back().px.y());
     wf.p_w = a.R * (Eigen::Vector3d(f.obs[0].xy.x(), f.obs[0].xy.y(), 1.0) / f.inv_depth) + a.p;
     wf.weight = static_cast<float>(mode.loss == BaLoss::Dynavins ? f.weight : 1.0);
+    if (std::getenv("DV_DEBUG_W") && f.sim_label == 0 && f.weight < 0.5 && f.times_solved >= 10) {
+      std::string per;
+      const CameraPose anc = state.camera(f.start_slot, 0);
+      const Eigen::Vector3d pw = wf.p_w;
+      for (size_t k = 0; k < f.obs.size(); ++k) {
+        const CameraPose c = state.camera(f.start_slot + k, 0);
+        const Eigen::Vector3d pc = c.R.transpose() * (pw - c.p);
+        per += fmt::format(" {:.1f}", 460 * (pc.head<2>() / pc.z() - f.obs[k].xy).norm());
+      }
+      spdlog::info("lowstatic id={} w={:.2f} n={} depth={:.1f} r={:.2f} right0={} px=({:.0f},{:.0f}) err460:{}", id, f.weight,
+                   f.times_solved, 1 / f.inv_depth, optimizer.featureResidual(state, f), f.obs[0].has_right, wf.u, wf.v, per);
+    }
     wf.times_solved = f.times_solved;
     wf.sim_label = f.sim_label;
     e.features.features.push_back(wf);

@@ -1,5 +1,6 @@
 #include "stages/estimator/window_optimizer.hpp"
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <unordered_map>
@@ -90,22 +91,74 @@ void WindowOptimizer::reset() {
   prior_blocks_.clear();
 }
 
-double WindowOptimizer::featureResidual(const WindowState& s, const WindowFeature& f) const {
-  const CameraPose anchor = s.camera(f.start_slot, 0);
-  const Eigen::Vector3d p_w =
-      anchor.R * (Eigen::Vector3d(f.obs[0].xy.x(), f.obs[0].xy.y(), 1.0) / f.inv_depth) + anchor.p;
-  auto squared = [&](const CameraPose& c, const Eigen::Vector2d& xy) {
-    const Eigen::Vector3d p_c = c.R.transpose() * (p_w - c.p);
-    if (p_c.z() <= 1e-3) return 1e4;  // behind the camera: as bad as it gets
-    return (opt_.sqrt_info * (p_c.head<2>() / p_c.z() - xy)).squaredNorm();
+namespace {
+
+/// The observations of one feature that the weight step looks at, projected from the anchor bearing at
+/// inverse depth `rho` with the poses fixed.
+struct FeatureGeometry {
+  struct Obs {
+    CameraPose cam;
+    Eigen::Vector2d xy;
+    bool weighted;  ///< false for the anchor's own stereo observation (paper III-D)
   };
-  std::vector<double> sq;
-  for (size_t k = 1; k < f.obs.size(); ++k) {
-    const int j = f.start_slot + static_cast<int>(k);
-    sq.push_back(squared(s.camera(j, 0), f.obs[k].xy));
-    if (opt_.stereo && f.obs[k].has_right) sq.push_back(squared(s.camera(j, 1), f.obs[k].xy_right));
+  CameraPose anchor;
+  Eigen::Vector3d bearing;  ///< anchor cam0, z = 1
+  std::vector<Obs> obs;
+  double sqrt_info = 1;
+
+  Eigen::Vector2d residual(const Obs& o, double rho) const {
+    const Eigen::Vector3d p_w = anchor.R * (bearing / rho) + anchor.p;
+    const Eigen::Vector3d p_c = o.cam.R.transpose() * (p_w - o.cam.p);
+    if (p_c.z() <= 1e-3) return Eigen::Vector2d(1e2, 1e2);  // behind the camera: as bad as it gets
+    return sqrt_info * (p_c.head<2>() / p_c.z() - o.xy);
   }
-  return meanSquaredResidual(sq);
+  /// Mean squared whitened residual of the weighted observations (r_j of feature_weights.hpp).
+  double weightedMean(double rho) const {
+    std::vector<double> sq;
+    for (const Obs& o : obs)
+      if (o.weighted) sq.push_back(residual(o, rho).squaredNorm());
+    return meanSquaredResidual(sq);
+  }
+  /// Inverse depth that best explains every observation with the poses fixed (1-D Gauss-Newton).
+  double bestInverseDepth(double rho) const {
+    for (int it = 0; it < 5; ++it) {
+      const double h = 1e-6 * std::max(rho, 1e-3);
+      double H = 0, b = 0;
+      for (const Obs& o : obs) {
+        const Eigen::Vector2d e = residual(o, rho);
+        const Eigen::Vector2d J = (residual(o, rho + h) - e) / h;
+        H += J.squaredNorm();
+        b += J.dot(e);
+      }
+      if (!(H > 0)) break;
+      const double step = -b / H;
+      rho = std::clamp(rho + step, 1e-3, 10.0);  // depth between 0.1 m and 1 km
+      if (std::abs(step) < 1e-6) break;
+    }
+    return rho;
+  }
+};
+
+}  // namespace
+
+double WindowOptimizer::featureResidual(const WindowState& s, const WindowFeature& f) const {
+  // r_j is measured at the depth that best explains all the feature's observations with the poses
+  // fixed, not at the BA's current depth: once a feature's weight is low, the unweighted stereo
+  // residual alone sets its BA depth, and a distant point with a slightly wrong disparity would then
+  // keep a large temporal residual and never win its weight back. With the depth profiled out, r_j asks
+  // only "is this track consistent with a static point under the estimated motion?". The stereo
+  // observations of every frame stay in that fit, so an object moving with the camera (which a point at
+  // infinity would explain without them) still does not fit.
+  FeatureGeometry g;
+  g.anchor = s.camera(f.start_slot, 0);
+  g.bearing = Eigen::Vector3d(f.obs[0].xy.x(), f.obs[0].xy.y(), 1.0);
+  g.sqrt_info = opt_.sqrt_info;
+  for (size_t k = 0; k < f.obs.size(); ++k) {
+    const int j = f.start_slot + static_cast<int>(k);
+    if (k > 0) g.obs.push_back({s.camera(j, 0), f.obs[k].xy, true});
+    if (opt_.stereo && f.obs[k].has_right) g.obs.push_back({s.camera(j, 1), f.obs[k].xy_right, k > 0});
+  }
+  return g.weightedMean(g.bestInverseDepth(f.inv_depth));
 }
 
 SolveStats WindowOptimizer::solve(WindowState& s, int newest, WindowFeatures& features) {

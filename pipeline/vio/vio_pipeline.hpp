@@ -1,0 +1,80 @@
+#pragma once
+// The visual-inertial run (DESIGN.md §2) wired on pipeline::Pipeline, one thread per box:
+//
+//   replay ─┬─ stereo frames (SPSC, 8) ──▶ tracker ── tracked frames ──┐
+//           │                                                          ▼ (fan-in)
+//           └─ IMU + frame times (SPSC, 4000) ──▶ imu ── intervals ──▶ estimator ── estimates ──▶ writer
+//                                                   ▲                      │
+//                                                   └─ latest NavState ────┘ (LatestValue: biases)
+//
+// rate 0: every queue blocks (lossless, repeatable); rate > 0: the frame queue drops the oldest frames
+// when the tracker falls behind (counted). IMU is never dropped: a full IMU queue in real time is an error.
+// End of input, SIGINT or a stop request drain every queue before runVio() returns.
+
+#include <cstddef>
+#include <cstdint>
+#include <functional>
+#include <string>
+#include <vector>
+
+#include "io/sensor_source.hpp"
+#include "pipeline/pipeline.hpp"
+#include "pipeline/replay.hpp"
+#include "pipeline/stop_flag.hpp"
+#include "stages/common/estimator_options.hpp"
+#include "stages/estimator/sliding_window_estimator.hpp"
+#include "stages/estimator/window_estimate.hpp"
+#include "stages/imu/frame_imu_pairer.hpp"
+#include "stages/imu/imu_stage.hpp"
+
+namespace dynavins::pipeline {
+
+/// What one run does.
+struct VioRunOptions {
+  EstimatorOptions estimator;        ///< the loaded yaml (with any --set overrides)
+  estimator::EstimatorMode mode;     ///< BA loss, stereo or mono
+  double rate = 0.0;                 ///< x real time; 0 = as fast as possible, lossless
+  bool show_progress = true;         ///< replay progress line on the terminal
+  double imu_rate_hz = 200.0;        ///< nominal IMU rate (gap detection)
+  ImuNoiseConvention imu_noise = ImuNoiseConvention::VinsFusion;
+  std::size_t frame_queue = 8;       ///< stereo frames waiting for the tracker
+  std::size_t imu_queue = 4000;      ///< IMU samples and frame times waiting for the IMU stage
+  std::size_t estimator_queue = 64;  ///< tracked frames and intervals waiting for the estimator
+  std::size_t output_queue = 64;     ///< estimates waiting for the writer
+};
+
+/// Where the estimates go; called on the writer thread, one call per processed frame, in time order.
+struct VioSinks {
+  std::function<void(const estimator::WindowEstimate&)> estimate;
+};
+
+/// Everything a run measured; the stage counters are read after all threads have ended.
+struct VioRunResult {
+  RunReport report;        ///< per-thread timing, per-queue depth and drops, error, interrupted
+  ReplayStats replay;      ///< events replayed, sensor time covered
+  std::string source;      ///< the source's description
+  int64_t frames_dropped = 0;   ///< stereo frames lost in the frame queue (rate > 0 only)
+  int64_t frames_tracked = 0;   ///< frames the tracker processed
+  int64_t frames_estimated = 0; ///< frames the estimator processed (= estimates written)
+  int64_t frames_tracking = 0;  ///< estimates with status Tracking
+  int64_t resets = 0;           ///< estimates with status Reset
+  ImuStageStats imu;
+  ImuIntervalBuilderStats imu_builder;
+  FrameImuPairerStats pairer;
+  std::vector<GroundTruthState> ground_truth;  ///< the source's ground truth, in time order
+  bool interrupted() const { return report.interrupted || replay.stopped; }
+};
+
+/// Throws std::invalid_argument naming the problem when `options` cannot run (stereo without cam1,
+/// no IMU, negative rate, zero queue capacity). runVio() calls it first; callers may call it before
+/// creating outputs.
+void checkVioOptions(const VioRunOptions& options);
+
+/// Runs `source` through tracker, IMU stage and estimator until its end, SIGINT or `external_stop`
+/// (may be null; polled by the replay thread). Blocks until every thread has ended. Throws
+/// std::invalid_argument for options that cannot run (stereo without cam1, no IMU); a failure inside
+/// a thread is returned in result.report (ok == false, error, failed_thread).
+VioRunResult runVio(io::SensorSource& source, const VioRunOptions& options, const VioSinks& sinks,
+                    const StopFlag* external_stop = nullptr);
+
+}  // namespace dynavins::pipeline
