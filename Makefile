@@ -17,17 +17,19 @@ build: deps
 	cmake -S . -B $(BUILD) $(CMAKE_GEN) -DCMAKE_BUILD_TYPE=Release
 	cmake --build $(BUILD)
 
-# The main job on the built-in default. Until the estimator lands (`run`), this is the most complete
-# thing there is: the `high` dynamic scene generated once (cached in bench/cache/high: stereo LCM
-# log, ground truth, preview images), replayed through the pipeline's queues at full speed, and the
-# stage-thread framework paced in real time with a tracker too slow to keep up (drops counted).
+# The main job on the built-in default: the `high` dynamic scene (two trucks crossing close in front
+# of the camera) generated once with its EuRoC folder and VINS-Fusion config (cached in
+# bench/cache/high), the estimator run on it with the Huber baseline and with DynaVINS weights, both
+# compared against the ground truth (table + top-view plot), and the DynaVINS run's weighted
+# features drawn on the frames with the most moving features (green: kept, red cross: rejected).
 demo: build
 	$(BUILD)/bin/dynavins info
-	./scripts/cached-sim.sh high
-	$(BUILD)/bin/dynavins log-info bench/cache/high/sensors.lcmlog
-	$(BUILD)/bin/dynavins replay --log bench/cache/high/sensors.lcmlog --rate 0
-	$(BUILD)/bin/dynavins pipeline-check --frames 200 --rate 1 --work-ms 80 --out $(BUILD)/demo/realtime
-	@echo "demo: the high scene's busiest stereo frame is bench/cache/high/preview.png (moving pixels: preview_labels.png)"
+	DYNAVINS=$(BUILD)/bin/dynavins ./scripts/cached-sim.sh high --euroc
+	$(BUILD)/bin/dynavins run --config bench/cache/high/euroc/vins_config.yaml --euroc bench/cache/high/euroc --ba huber --out runs/high-huber
+	$(BUILD)/bin/dynavins run --config bench/cache/high/euroc/vins_config.yaml --euroc bench/cache/high/euroc --ba dynavins --out runs/high-dynavins
+	$(BUILD)/bin/dynavins compare runs/high-huber runs/high-dynavins --plot runs/high-compare.png
+	$(BUILD)/bin/dynavins overlay --euroc bench/cache/high/euroc --features runs/high-dynavins/features.csv --frames 4 --out runs/high-dynavins/overlay.png
+	@echo "demo: trajectories in runs/high-compare.png, weighted features in runs/high-dynavins/overlay.png"
 
 test: build
 	ctest --test-dir $(BUILD) --output-on-failure -j $(CTEST_J)

@@ -1,8 +1,6 @@
 // bench_estimator: one scenario, huber and dynavins side by side through the deterministic sequential
 // chain (tracker -> IMU -> estimator on one thread): ATE, feature scoring, BA ms.
 //   bench_estimator --scenario high [--duration S] [--mono] [--ba huber,dynavins]
-#include <unistd.h>
-
 #include <filesystem>
 #include <sstream>
 #include <iostream>
@@ -10,6 +8,7 @@
 #include <CLI/CLI.hpp>
 #include <spdlog/spdlog.h>
 
+#include "bench/scenario_options.hpp"
 #include "bench/sequential_vio.hpp"
 #include "eval/evaluation.hpp"
 #include "eval/trajectory_io.hpp"
@@ -17,6 +16,57 @@
 #include "sim/scenario/scenario_spec.hpp"
 
 using namespace dynavins;
+
+namespace {
+/// How far each static track strays from its true 3-D point: the point is fixed at the track's first
+/// observation (true depth under the pixel) and projected with the true pose into every later frame.
+class TrackTruth {
+ public:
+  TrackTruth(const sim::ScenarioSource& src, const sim::Scenario& sc) : src_(src), sc_(sc) {}
+  void operator()(const TrackedFrame& f) {
+    const double t = (f.t_ns - sc_.epoch_ns) * 1e-9;
+    Eigen::Isometry3d T_wb = Eigen::Isometry3d::Identity();
+    T_wb.linear() = sc_.body->rotation(t);
+    T_wb.translation() = sc_.body->position(t);
+    const Eigen::Isometry3d T_wc = T_wb * sc_.rig.T_body_cam0;
+    const cv::Mat& depth = src_.last_left().depth;
+    for (const TrackedFeature& tf : f.features) {
+      if (tf.sim_label != 0) continue;
+      auto it = points_.find(tf.id);
+      if (it == points_.end()) {
+        // Bilinear true depth under the sub-pixel corner; corners on a depth edge are left unscored.
+        const int c = static_cast<int>(std::floor(tf.px.x())), r = static_cast<int>(std::floor(tf.px.y()));
+        if (r < 1 || c < 1 || r + 2 >= depth.rows || c + 2 >= depth.cols) continue;
+        float lo = 1e9f, hi = 0.f;
+        for (int dr = -1; dr <= 2; ++dr)
+          for (int dc = -1; dc <= 2; ++dc) lo = std::min(lo, depth.at<float>(r + dr, c + dc)), hi = std::max(hi, depth.at<float>(r + dr, c + dc));
+        if (!(lo > 0) || hi > 1.05f * lo || hi > 1e3f) continue;
+        const double a = tf.px.x() - c, b = tf.px.y() - r;
+        const double z = (1 - a) * (1 - b) * depth.at<float>(r, c) + a * (1 - b) * depth.at<float>(r, c + 1) +
+                         (1 - a) * b * depth.at<float>(r + 1, c) + a * b * depth.at<float>(r + 1, c + 1);
+        points_[tf.id] = T_wc * Eigen::Vector3d(tf.xy.x() * z, tf.xy.y() * z, z);
+        max_err_[tf.id] = 0;
+        continue;
+      }
+      const Eigen::Vector3d p_c = T_wc.inverse() * it->second;
+      if (p_c.z() <= 0) continue;
+      const double e = 460.0 * (p_c.head<2>() / p_c.z() - tf.xy).norm();
+      max_err_[tf.id] = std::max(max_err_[tf.id], e);
+    }
+  }
+  /// Largest error of the track so far [px at 460], or -1 when unknown.
+  double maxError(int64_t id) const {
+    auto it = max_err_.find(id);
+    return it == max_err_.end() ? -1 : it->second;
+  }
+
+ private:
+  const sim::ScenarioSource& src_;
+  const sim::Scenario& sc_;
+  std::map<int64_t, Eigen::Vector3d> points_;
+  std::map<int64_t, double> max_err_;
+};
+}  // namespace
 
 int main(int argc, char** argv) {
   CLI::App app{"Huber vs DynaVINS on one simulated scenario (sequential, deterministic)"};
@@ -36,10 +86,7 @@ int main(int argc, char** argv) {
   std::string path = scenario;
   if (!std::filesystem::is_regular_file(path)) path = std::string(DYNAVINS_SOURCE_DIR) + "/bench/scenarios/" + scenario + ".yaml";
   const auto sc = sim::build_scenario(sim::load_scenario(path), std::nullopt, duration);
-  const auto dir = std::filesystem::temp_directory_path() / ("bench_estimator_" + std::to_string(::getpid()));
-  io::write_vins_stereo_config(dir.string(), sim::vins_config(*sc));
-  const EstimatorOptions opt = EstimatorOptions::load((dir / "vins_config.yaml").string());
-  std::filesystem::remove_all(dir);
+  const EstimatorOptions opt = bench::scenarioEstimatorOptions(*sc);
 
   std::stringstream ss(modes);
   std::string m;
@@ -48,7 +95,8 @@ int main(int argc, char** argv) {
     mode.loss = estimator::parseBaLoss(m);
     mode.stereo = !mono;
     sim::ScenarioSource src(sc);
-    const auto r = bench::runSequentialVio(src, opt, mode);
+    TrackTruth truth(src, *sc);
+    const auto r = bench::runSequentialVio(src, opt, mode, [&truth](const TrackedFrame& f) { truth(f); });
     if (!out_dir.empty()) {
       std::filesystem::create_directories(out_dir);
       eval::write_tum(out_dir + "/" + m + ".tum", r.estimate);
@@ -71,6 +119,42 @@ int main(int argc, char** argv) {
                 "moving %d rejected %.1f%% | static %d kept %.1f%%\n",
                 m.c_str(), scenario.c_str(), mono ? "mono" : "stereo", ate, r.frames, r.tracking_frames, r.resets,
                 mean, p95, sw.moving, 100 * sw.moving_rejected, sw.static_, 100 * sw.static_kept);
+    int low_by_n[4] = {0, 0, 0, 0};  // static features ending under 0.5, by solves: 1, 2-3, 4-9, 10+
+    for (const auto& [id, f] : r.features) {
+      if (f.sim_label != 0 || f.weight >= 0.5f || f.times_solved == 0) continue;
+      ++low_by_n[f.times_solved == 1 ? 0 : f.times_solved < 4 ? 1 : f.times_solved < 10 ? 2 : 3];
+    }
+    int kept_good = 0, good = 0, drifted = 0, drifted_low = 0;  // static tracks true to 2 px, and the rest
+    for (const auto& [id, f] : r.features) {
+      if (f.sim_label != 0 || f.times_solved == 0) continue;
+      const double e = truth.maxError(id);
+      if (e < 0) continue;
+      if (e <= 2.0) {
+        ++good;
+        kept_good += f.weight > 0.5f;
+      } else {
+        ++drifted;
+        drifted_low += f.weight < 0.5f;
+      }
+    }
+    std::vector<double> e_low, e_high;
+    for (const auto& [id, f] : r.features) {
+      if (f.sim_label != 0 || f.times_solved == 0 || truth.maxError(id) < 0) continue;
+      (f.weight < 0.5f ? e_low : e_high).push_back(truth.maxError(id));
+    }
+    auto q = [](std::vector<double> v, double p) {
+      if (v.empty()) return -1.0;
+      std::sort(v.begin(), v.end());
+      return v[static_cast<size_t>(p * (v.size() - 1))];
+    };
+    std::printf("          true track error [px] of static features, weight < 0.5: p10 %.1f p50 %.1f p90 %.1f (n=%zu); "
+                ">= 0.5: p10 %.1f p50 %.1f p90 %.1f (n=%zu)\n",
+                q(e_low, 0.1), q(e_low, 0.5), q(e_low, 0.9), e_low.size(), q(e_high, 0.1), q(e_high, 0.5), q(e_high, 0.9),
+                e_high.size());
+    std::printf("          static tracks true within 2 px: %d, kept %.1f%% | drifted > 2 px: %d, rejected %.1f%%\n", good,
+                good ? 100.0 * kept_good / good : 0.0, drifted, drifted ? 100.0 * drifted_low / drifted : 0.0);
+    std::printf("          static under 0.5 by solves: 1: %d, 2-3: %d, 4-9: %d, 10+: %d\n", low_by_n[0], low_by_n[1],
+                low_by_n[2], low_by_n[3]);
     std::fflush(stdout);
   }
   return 0;

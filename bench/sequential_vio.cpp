@@ -20,7 +20,8 @@ eval::StampedPose stamped(int64_t t_ns, const Eigen::Vector3d& p, const Eigen::Q
 }  // namespace
 
 SequentialVioResult runSequentialVio(io::SensorSource& source, const EstimatorOptions& options,
-                                     const estimator::EstimatorMode& mode) {
+                                     const estimator::EstimatorMode& mode,
+                                     const std::function<void(const TrackedFrame&)>& on_tracked) {
   SequentialVioResult out;
   StereoTracker tracker(TrackerOptions::from(options), options.cameras.at(0),
                         mode.stereo ? options.cameras.at(1) : nullptr);
@@ -68,6 +69,7 @@ SequentialVioResult runSequentialVio(io::SensorSource& source, const EstimatorOp
       if (!mode.stereo) frame.right = cv::Mat();
       const auto t0 = std::chrono::steady_clock::now();
       waiting.push_back(tracker.process(frame));
+      if (on_tracked) on_tracked(waiting.back());
       out.tracker_ms.push_back(
           std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count());
       consume(imu.addFrame(frame.t_ns));

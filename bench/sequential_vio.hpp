@@ -3,6 +3,7 @@
 // deterministic twin of `dynavins run` (same stages, no queues), for tests and benches that must give the
 // same answer every time.
 
+#include <functional>
 #include <map>
 #include <vector>
 
@@ -29,9 +30,11 @@ struct SequentialVioResult {
   int frames = 0, tracking_frames = 0, resets = 0;
 };
 
-/// Runs tracker -> IMU intervals -> estimator over every event of `source`.
+/// Runs tracker -> IMU intervals -> estimator over every event of `source`. `on_tracked`, when set, sees
+/// every tracked frame right after the tracker (e.g. to score tracks against simulator truth).
 SequentialVioResult runSequentialVio(io::SensorSource& source, const EstimatorOptions& options,
-                                     const estimator::EstimatorMode& mode);
+                                     const estimator::EstimatorMode& mode,
+                                     const std::function<void(const TrackedFrame&)>& on_tracked = {});
 
 /// Share of moving-object features (label > 0) with weight < 0.5, and of static ones (label 0) with
 /// weight > 0.5, among features that went through at least one solve.

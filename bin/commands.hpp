@@ -25,5 +25,7 @@ void add_convert_command(CLI::App& app);
 void add_replay_command(CLI::App& app);
 void add_sim_command(CLI::App& app);
 void add_run_command(CLI::App& app);
+void add_compare_command(CLI::App& app);
+void add_overlay_command(CLI::App& app);
 
 }  // namespace dynavins::cli

@@ -29,6 +29,8 @@ int main(int argc, char** argv) {
   dynavins::cli::add_replay_command(app);
   dynavins::cli::add_eval_command(app);
   dynavins::cli::add_run_command(app);
+  dynavins::cli::add_compare_command(app);
+  dynavins::cli::add_overlay_command(app);
 
   try {
     app.parse(argc, argv);

@@ -1,0 +1,52 @@
+// A short deterministic scene where a truck crossing 5 m ahead fills most of the image for about two
+// seconds (tests/data/scenarios/truck_crossing.yaml): the DynaVINS weights keep the pose within an honest
+// bound of the simulator's ground truth, while the Huber baseline (VINS-Fusion's loss) does not.
+// Measured when written: dynavins ATE 0.12 m, no reset, 98.9% of truck features rejected;
+// huber ATE 6.5 m with 2 resets.
+#include "tests/estimator/catch_with_ceres.hpp"
+
+#include "bench/scenario_options.hpp"
+#include "bench/sequential_vio.hpp"
+#include "eval/evaluation.hpp"
+#include "sim/scenario/scenario_spec.hpp"
+
+using namespace dynavins;
+
+namespace {
+constexpr double kAteBound = 0.3;  // metres over a 12 s, ~35 m flight
+
+struct Outcome {
+  bench::SequentialVioResult run;
+  double ate = 1e9;
+};
+
+Outcome runScene(const std::shared_ptr<const sim::Scenario>& sc, estimator::BaLoss loss) {
+  sim::ScenarioSource src(sc);
+  estimator::EstimatorMode mode;
+  mode.loss = loss;
+  Outcome o;
+  o.run = bench::runSequentialVio(src, bench::scenarioEstimatorOptions(*sc), mode);
+  o.ate = eval::evaluate(o.run.ground_truth, o.run.estimate).ate.rmse;
+  return o;
+}
+}  // namespace
+
+TEST_CASE("truck crossing ahead: dynavins holds where huber does not", "[estimator][dynamic]") {
+  const auto sc = sim::build_scenario(
+      sim::load_scenario(std::string(DYNAVINS_SOURCE_DIR) + "/tests/data/scenarios/truck_crossing.yaml"));
+
+  const Outcome dyn = runScene(sc, estimator::BaLoss::Dynavins);
+  INFO("dynavins ATE " << dyn.ate << " m, resets " << dyn.run.resets);
+  CHECK(dyn.run.resets == 0);
+  CHECK(dyn.run.tracking_frames >= 0.9 * dyn.run.frames);
+  CHECK(dyn.ate < kAteBound);
+  const bench::WeightScore score = bench::scoreWeights(dyn.run.features);
+  REQUIRE(score.moving > 50);  // the truck was seen and its features went through the BA
+  CHECK(score.moving_rejected >= 0.9);
+
+  const Outcome hub = runScene(sc, estimator::BaLoss::Huber);
+  INFO("huber ATE " << hub.ate << " m, resets " << hub.run.resets);
+  // The baseline either loses the pose (a reset restarts it from the origin) or drifts past the bound.
+  CHECK((hub.run.resets > 0 || hub.ate > kAteBound));
+  CHECK(hub.ate > 3 * dyn.ate);
+}

@@ -1,0 +1,41 @@
+// The estimator on real data: VINS-Fusion's own EuRoC stereo-inertial config, unchanged, on the EuRoC V1_01
+// clip in ../shared, where the sensor stands still. It must initialise from standstill and stay put.
+#include "tests/estimator/catch_with_ceres.hpp"
+
+#include <filesystem>
+
+#include "bench/sequential_vio.hpp"
+#include "io/euroc_dataset.hpp"
+#include "io/euroc_source.hpp"
+
+using namespace dynavins;
+
+namespace {
+const std::string kShared = DYNAVINS_SHARED_DIR;
+
+double maxDistanceFromStart(const eval::Trajectory& t) {
+  double d = 0;
+  for (const auto& p : t.poses) d = std::max(d, (p.p - t.poses.front().p).norm());
+  return d;
+}
+}  // namespace
+
+TEST_CASE("EuRoC clip with VINS-Fusion's stereo-imu config: initialises at standstill and stays within 5 cm",
+          "[estimator][euroc]") {
+  const std::string config = kShared + "/data/vins_fusion_euroc_config/euroc_stereo_imu_config.yaml";
+  const std::string clip = kShared + "/data/euroc_v1_01_micro";
+  REQUIRE(std::filesystem::is_regular_file(config));
+  const EstimatorOptions opt = EstimatorOptions::load(config);
+  for (auto loss : {estimator::BaLoss::Huber, estimator::BaLoss::Dynavins}) {
+    INFO("BA " << estimator::toString(loss));
+    io::EurocSource src(std::make_shared<io::EurocDataset>(clip));
+    estimator::EstimatorMode mode;
+    mode.loss = loss;
+    const auto r = bench::runSequentialVio(src, opt, mode);
+    CHECK(r.resets == 0);
+    // 11 frames fill the window; every frame after that is tracked.
+    CHECK(r.tracking_frames >= r.frames - opt.window_size - 1);
+    REQUIRE(r.tracking_frames > 50);
+    CHECK(maxDistanceFromStart(r.estimate) < 0.05);
+  }
+}
