@@ -81,6 +81,7 @@ struct SlidingWindowEstimator::Impl {
   int newest = -1;  ///< slot of the latest frame; -1 when empty
   bool tracking = false;
   bool gravity_aligned = false;
+  std::string last_init_failure;  ///< last reason initialisation failed, logged when it changes
 };
 
 void SlidingWindowEstimator::Impl::resetAll() {
@@ -205,7 +206,7 @@ bool SlidingWindowEstimator::Impl::initializeMonoWindow(std::string* why) {
     window[k].preint = k > 0 ? state.preint[k].get() : nullptr;
   }
   for (const auto& [id, f] : features.all()) {
-    for (size_t o = 0; o < f.obs.size(); ++o) window[f.start_slot + o].features[static_cast<int>(id)] = f.obs[o].xy;
+    for (size_t o = 0; o < f.obs.size(); ++o) window[f.start_slot + o].features[id] = f.obs[o].xy;
   }
   const Eigen::Isometry3d T_bc = extrinsicOf(state.extrinsic[0]);
   MonoInitOptions mo;
@@ -215,6 +216,10 @@ bool SlidingWindowEstimator::Impl::initializeMonoWindow(std::string* why) {
     *why = r.reason;
     return false;
   }
+  spdlog::debug("mono initialisation: SfM reference frame {} ({:.2f} px RMS), scale {:.3f} (relative std {:.3f}), "
+                "bg ({:.4f}, {:.4f}, {:.4f}), newest speed {:.2f} m/s",
+                r.sfm_reference_frame, r.sfm_rms_reprojection_px, r.scale, r.scale_relative_std, r.bg.x(), r.bg.y(),
+                r.bg.z(), r.v_wb[newest].norm());
   for (int k = 0; k <= newest; ++k) {
     state.q(k) = Eigen::Quaterniond(r.R_wb[k]).normalized();
     state.p(k) = r.p_wb[k];
@@ -223,7 +228,7 @@ bool SlidingWindowEstimator::Impl::initializeMonoWindow(std::string* why) {
   }
   for (auto& [id, f] : features.all()) {
     f.has_depth = false;
-    auto it = r.depths.find(static_cast<int>(id));
+    auto it = r.depths.find(id);
     if (it != r.depths.end() && it->second.anchor_frame == f.start_slot && it->second.depth > 0.1) {
       f.inv_depth = 1.0 / it->second.depth;
       f.has_depth = true;
@@ -286,18 +291,6 @@ void SlidingWindowEstimator::Impl::fillOutput(WindowEstimate& e) {
     wf.v = static_cast<float>(f.obs.back().px.y());
     wf.p_w = a.R * (Eigen::Vector3d(f.obs[0].xy.x(), f.obs[0].xy.y(), 1.0) / f.inv_depth) + a.p;
     wf.weight = static_cast<float>(mode.loss == BaLoss::Dynavins ? f.weight : 1.0);
-    if (std::getenv("DV_DEBUG_W") && f.sim_label == 0 && f.weight < 0.5 && f.times_solved >= 10) {
-      std::string per;
-      const CameraPose anc = state.camera(f.start_slot, 0);
-      const Eigen::Vector3d pw = wf.p_w;
-      for (size_t k = 0; k < f.obs.size(); ++k) {
-        const CameraPose c = state.camera(f.start_slot + k, 0);
-        const Eigen::Vector3d pc = c.R.transpose() * (pw - c.p);
-        per += fmt::format(" {:.1f}", 460 * (pc.head<2>() / pc.z() - f.obs[k].xy).norm());
-      }
-      spdlog::info("lowstatic id={} w={:.2f} n={} depth={:.1f} r={:.2f} right0={} px=({:.0f},{:.0f}) err460:{}", id, f.weight,
-                   f.times_solved, 1 / f.inv_depth, optimizer.featureResidual(state, f), f.obs[0].has_right, wf.u, wf.v, per);
-    }
     wf.times_solved = f.times_solved;
     wf.sim_label = f.sim_label;
     e.features.features.push_back(wf);
@@ -350,7 +343,9 @@ WindowEstimate SlidingWindowEstimator::Impl::process(const TrackedFrame& frame, 
     std::string why;
     const bool ok = mode.stereo ? initializeStereo(&why) : initializeMonoWindow(&why);
     if (!ok) {
-      spdlog::debug("initialisation at t={:.3f} s not yet: {}", frame.t_ns * 1e-9, why);
+      // Each new reason once at info (a standing camera would otherwise say the same every frame).
+      if (why != last_init_failure) spdlog::info("not initialised yet at t={:.3f} s: {}", frame.t_ns * 1e-9, why);
+      last_init_failure = why;
       slide(true);  // drop the oldest and keep collecting
       return finish(e);
     }

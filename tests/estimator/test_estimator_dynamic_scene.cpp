@@ -25,7 +25,9 @@ Outcome runScene(const std::shared_ptr<const sim::Scenario>& sc, estimator::BaLo
   estimator::EstimatorMode mode;
   mode.loss = loss;
   Outcome o;
-  o.run = bench::runSequentialVio(src, bench::scenarioEstimatorOptions(*sc), mode);
+  EstimatorOptions opt = bench::scenarioEstimatorOptions(*sc);
+  opt.max_solver_time = 1e3;  // iteration-bound, so the answer does not depend on machine load
+  o.run = bench::runSequentialVio(src, opt, mode);
   o.ate = eval::evaluate(o.run.ground_truth, o.run.estimate).ate.rmse;
   return o;
 }

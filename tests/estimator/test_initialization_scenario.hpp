@@ -22,6 +22,10 @@ namespace dynavins::estimator::test {
 
 struct ScenarioOptions {
   bool pure_rotation = false;
+  /// Straight line at 3 m/s, no acceleration (rotations as usual): the metric scale is not observable.
+  bool constant_velocity = false;
+  /// Feature ids i * 2^32 + 1 instead of i: all equal once truncated to 32 bits.
+  bool wide_ids = false;
   double pixel_noise_px = 0.0;  ///< std of the observation noise [px] at focal 460
   bool imu_noise = false;       ///< EuRoC-grade white noise and bias walk
   Eigen::Vector3d gyro_bias = Eigen::Vector3d(0.02, -0.015, 0.025);
@@ -36,7 +40,7 @@ struct Scenario {
   std::vector<sim::KinematicState> truth;  ///< body truth per frame
   Eigen::Matrix3d R_bc;
   Eigen::Vector3d p_bc;
-  std::map<int, Eigen::Vector3d> landmarks_w;
+  std::map<FeatureId, Eigen::Vector3d> landmarks_w;
   std::vector<FrameFeatures> features;
   std::vector<std::unique_ptr<ImuPreintegration>> preints;  ///< frame k -> k+1
 
@@ -60,13 +64,15 @@ struct Scenario {
   }
 };
 
-inline sim::SmoothTrajectory scenarioTrajectory(bool pure_rotation) {
+inline sim::SmoothTrajectory scenarioTrajectory(bool pure_rotation, bool constant_velocity = false) {
   std::vector<sim::Waypoint> w;
   for (int i = 0; i <= 12; ++i) {
     const double t = 0.25 * i;
     sim::Waypoint p;
     p.t = t;
-    if (!pure_rotation)
+    if (constant_velocity)
+      p.p = Eigen::Vector3d(3.0 * t, 0.0, 0.0);
+    else if (!pure_rotation)
       p.p = Eigen::Vector3d(0.8 * t + 0.3 * std::sin(3.0 * t), 0.4 * std::sin(2.2 * t), 0.25 * std::sin(2.7 * t));
     p.yaw = 0.4 * std::sin(1.3 * t);
     p.pitch = 0.15 * std::sin(1.7 * t);
@@ -78,7 +84,7 @@ inline sim::SmoothTrajectory scenarioTrajectory(bool pure_rotation) {
 
 inline Scenario makeScenario(const ScenarioOptions& o = {}) {
   Scenario s;
-  s.traj = scenarioTrajectory(o.pure_rotation);
+  s.traj = scenarioTrajectory(o.pure_rotation, o.constant_velocity);
   // Camera looking along body x (body x forward, y left, z up; camera z forward, x right, y down).
   s.R_bc << 0, 0, 1, -1, 0, 0, 0, -1, 0;
   s.p_bc = Eigen::Vector3d(0.05, 0.02, -0.01);
@@ -95,7 +101,8 @@ inline Scenario makeScenario(const ScenarioOptions& o = {}) {
   for (int i = 0; i < o.landmarks; ++i) {
     const double z = depth(rng);
     const Eigen::Vector3d p_c(0.8 * u(rng) * z, 0.6 * u(rng) * z, z);
-    s.landmarks_w[i] = s.R_wc(mid) * p_c + s.p_wc(mid);
+    const FeatureId id = o.wide_ids ? (static_cast<FeatureId>(i) << 32) + 1 : i;
+    s.landmarks_w[id] = s.R_wc(mid) * p_c + s.p_wc(mid);
   }
   s.features.resize(n);
   for (int k = 0; k < n; ++k)

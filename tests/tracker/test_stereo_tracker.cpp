@@ -412,3 +412,50 @@ TEST_CASE("StereoTracker: EuRoC V1_01 clip with its own radtan calibration", "[t
   CHECK(median < 8.0);
   CHECK(plausible >= 0.98 * depths.size());
 }
+
+TEST_CASE("StereoTracker: CLAHE recovers features in a dark low-contrast image", "[tracker]") {
+  // A textured scene seen at night: the image squeezed into grey levels 2..8 with sensor noise on top.
+  // The corner detector's threshold is relative, but the noise is not: without equalisation the
+  // forward-backward check loses tracks; CLAHE (option `clahe`) stretches the local contrast first.
+  sim::CameraIntrinsics c;
+  const CameraModelPtr cam = camera_of(c, false);
+  cv::Mat img(c.height, c.width, CV_8UC1);
+  cv::RNG rng(9);
+  rng.fill(img, cv::RNG::UNIFORM, 0, 255);
+  cv::GaussianBlur(img, img, cv::Size(0, 0), 2.5);
+  cv::normalize(img, img, 0, 255, cv::NORM_MINMAX);
+  auto dark = [&](const cv::Mat& bright, uint64_t seed) {
+    cv::Mat f, noise(bright.size(), CV_32F);
+    bright.convertTo(f, CV_32F, 6.0 / 255.0, 2.0);
+    cv::RNG(seed).fill(noise, cv::RNG::NORMAL, 0.0, 1.0);
+    cv::Mat out;
+    cv::Mat(f + noise).convertTo(out, CV_8U);
+    return out;
+  };
+  const cv::Mat shift = (cv::Mat_<double>(2, 3) << 1, 0, 3.0, 0, 1, 2.0);  // 3 px right, 2 px down
+  cv::Mat moved;
+  cv::warpAffine(img, moved, shift, img.size(), cv::INTER_LINEAR, cv::BORDER_REFLECT);
+
+  auto correctly_tracked = [&](bool clahe) {
+    TrackerOptions opt;
+    opt.clahe = clahe;
+    StereoTracker tracker(opt, cam);
+    StereoFrame a, b;
+    a.left = dark(img, 1), b.left = dark(moved, 2), b.t_ns = 50'000'000;
+    const TrackedFrame fa = tracker.process(a);
+    const TrackedFrame fb = tracker.process(b);
+    std::map<int64_t, Eigen::Vector2d> first;
+    for (const auto& f : fa.features) first[f.id] = f.px;
+    int good = 0;
+    for (const auto& f : fb.features) {
+      auto it = first.find(f.id);
+      if (it != first.end() && (f.px - it->second - Eigen::Vector2d(3.0, 2.0)).norm() < 1.0) ++good;
+    }
+    return good;
+  };
+  const int off = correctly_tracked(false), on = correctly_tracked(true);
+  std::printf("dark image: %d tracks correct without CLAHE, %d with\n", off, on);
+  // Measured when written (deterministic seeds): 78 without, 103 with (tracks within 1 px of the true shift).
+  CHECK(on >= 1.2 * off);
+  CHECK(on >= 80);
+}

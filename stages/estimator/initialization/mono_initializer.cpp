@@ -48,6 +48,7 @@ MonoInitResult initializeMono(const std::vector<InitWindowFrame>& window, const 
     return res;
   }
   res.scale = al.scale;
+  res.scale_relative_std = al.scale_relative_std;
 
   // World: gravity on -z, then the yaw of frame 0's body removed (a rotation about z keeps gravity).
   Eigen::Matrix3d R_wc0 = rotationAligningGravity(al.g_c0);

@@ -44,7 +44,8 @@ struct MonoInitResult {
   std::vector<Eigen::Vector3d> v_wb;       ///< body velocity in the world per frame [m/s]
   Eigen::Vector3d bg = Eigen::Vector3d::Zero();  ///< gyroscope bias (the preintegrations' new linearisation bias)
   double scale = 0.0;                      ///< metric / SfM scale
-  std::map<int, FeatureDepth> depths;      ///< per feature id, for the SfM-triangulated features
+  double scale_relative_std = 0.0;         ///< std(scale) / scale of the alignment
+  std::map<FeatureId, FeatureDepth> depths;      ///< per feature id, for the SfM-triangulated features
   int sfm_reference_frame = -1;            ///< frame l of the SfM
   double sfm_rms_reprojection_px = 0.0;    ///< SfM bundle adjustment RMS error
 };

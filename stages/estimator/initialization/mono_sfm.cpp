@@ -3,6 +3,8 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <cstdio>
+#include <string>
 
 #include <ceres/ceres.h>
 #include <ceres/sphere_manifold.h>
@@ -40,7 +42,7 @@ Eigen::Vector3d bearing(const Eigen::Vector2d& x) { return Eigen::Vector3d(x.x()
 
 // Matched observations of two frames.
 struct Correspondences {
-  std::vector<int> ids;
+  std::vector<FeatureId> ids;
   std::vector<Eigen::Vector2d> a, b;
 };
 
@@ -108,7 +110,7 @@ class SfmBuilder {
   const std::vector<FrameFeatures>& frames_;
   const MonoSfmOptions& o_;
   std::vector<CameraPose> poses_;
-  std::map<int, Eigen::Vector3d> points_;
+  std::map<FeatureId, Eigen::Vector3d> points_;
   double rms_px_ = 0.0;
   int reference_ = 0;
 };
@@ -132,11 +134,24 @@ bool SfmBuilder::chooseReferenceFrame(int& l, Eigen::Matrix3d& R, Eigen::Vector3
     l = i;
     return true;
   }
-  why = "no reference frame: best common features " + std::to_string(best_common) + " (need " +
-        std::to_string(o_.min_common_features) + "), best parallax " + std::to_string(best_parallax) +
-        " px (need " + std::to_string(o_.min_parallax_px) + "), best parallax beyond pure rotation " +
-        std::to_string(best_translation_parallax) + " px (need " + std::to_string(o_.min_translation_parallax_px) +
-        "), or essential matrix failed";
+  // Name the first test that no candidate frame passed (the tests run in this order).
+  const auto num = [](double v) {
+    char buf[32];
+    std::snprintf(buf, sizeof buf, "%.1f", v);
+    return std::string(buf);
+  };
+  if (best_common < o_.min_common_features) {
+    why = "no reference frame: at most " + std::to_string(best_common) + " common features with the newest frame (need " +
+          std::to_string(o_.min_common_features) + ")";
+  } else if (best_parallax < o_.min_parallax_px) {
+    why = "not enough parallax: at most " + num(best_parallax) + " px mean feature motion across the window (need " +
+          num(o_.min_parallax_px) + "); the camera has not moved enough";
+  } else if (best_translation_parallax < o_.min_translation_parallax_px) {
+    why = "motion close to a pure rotation: at most " + num(best_translation_parallax) +
+          " px parallax beyond the best pure rotation (need " + num(o_.min_translation_parallax_px) + ")";
+  } else {
+    why = "no reference frame: the essential matrix failed for every frame with enough parallax";
+  }
   return false;
 }
 
@@ -198,7 +213,7 @@ bool SfmBuilder::solvePnP(int k, int guess_from, std::string& why) {
 
 void SfmBuilder::triangulateRemaining() {
   // Features not yet triangulated: use the first and last frames that observe them.
-  std::map<int, std::pair<int, int>> span;
+  std::map<FeatureId, std::pair<int, int>> span;
   for (int k = 0; k < static_cast<int>(frames_.size()); ++k)
     for (const auto& observation : frames_[k]) {
       const auto it = span.find(observation.first);
@@ -223,7 +238,7 @@ bool SfmBuilder::solveBundleAdjustment(std::string& why) {
     Eigen::Map<Eigen::Quaterniond>(q[k].data()) = poses_[k].q_cw;
     Eigen::Map<Eigen::Vector3d>(t[k].data()) = poses_[k].t_cw;
   }
-  std::map<int, std::array<double, 3>> pts;
+  std::map<FeatureId, std::array<double, 3>> pts;
   for (const auto& [id, p] : points_) pts[id] = {p.x(), p.y(), p.z()};
 
   ceres::Problem::Options po;

@@ -45,7 +45,7 @@ struct MonoSfmResult {
   int reference_frame = -1;             ///< l
   std::vector<Eigen::Matrix3d> R_lc;    ///< camera-to-l rotation of every frame
   std::vector<Eigen::Vector3d> p_lc;    ///< camera position of every frame in l
-  std::map<int, Eigen::Vector3d> points_l;  ///< triangulated features (id -> position in l)
+  std::map<FeatureId, Eigen::Vector3d> points_l;  ///< triangulated features (id -> position in l)
   double rms_reprojection_px = 0.0;     ///< after BA
 };
 

@@ -1,5 +1,6 @@
 #include "stages/estimator/initialization/visual_inertial_alignment.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <stdexcept>
 
@@ -17,6 +18,8 @@ constexpr double kScaleConditioning = 100.0;
 struct LinearSystem {
   Eigen::MatrixXd A;
   Eigen::VectorXd b;
+  double ztz = 0.0;  ///< squared norm of the stacked right-hand side
+  int rows = 0;      ///< stacked equations
 };
 
 LinearSystem buildSystem(const std::vector<Eigen::Matrix3d>& R, const std::vector<Eigen::Vector3d>& p,
@@ -61,6 +64,8 @@ LinearSystem buildSystem(const std::vector<Eigen::Matrix3d>& R, const std::vecto
     sys.A.block(3 * frames, 3 * k, gdim + 1, 6) += HtH.bottomLeftCorner(gdim + 1, 6);
     sys.b.segment(3 * k, 6) += Htz.head(6);
     sys.b.tail(gdim + 1) += Htz.tail(gdim + 1);
+    sys.ztz += z.squaredNorm();
+    sys.rows += 6;
   }
   return sys;
 }
@@ -113,15 +118,33 @@ VisualInertialAlignment alignVisualInertial(const std::vector<Eigen::Matrix3d>& 
   // §V-B-3: g = |g| ĝ0 + B w, w solved with the rest, ĝ re-normalised; a few iterations.
   Eigen::VectorXd xr = x;
   g = o.gravity_norm * g.normalized();
+  LinearSystem sys;
   for (int it = 0; it < o.refinement_iterations; ++it) {
     const Eigen::Matrix<double, 3, 2> B = gravityTangentBasis(g);
-    const LinearSystem sys = buildSystem(R_c0_b, p_c0_c, preints, p_bc, &g, &B);
+    sys = buildSystem(R_c0_b, p_c0_c, preints, p_bc, &g, &B);
     xr = sys.A.ldlt().solve(sys.b);
     g = o.gravity_norm * (g + B * xr.segment<2>(3 * frames)).normalized();
   }
-  const double s = xr(3 * frames + 2) / kScaleConditioning;
+  const int is = 3 * frames + 2;
+  const double s = xr(is) / kScaleConditioning;
   if (!xr.allFinite() || !(s > 0.0)) {
     res.reason = "alignment: refined scale " + std::to_string(s) + " not positive";
+    return res;
+  }
+  // Standard deviation of the scale from the last linear solve: residual variance times the scale's
+  // diagonal entry of the inverse normal matrix (both in the conditioned unknown, so the ratio is s's).
+  const int dof = sys.rows - static_cast<int>(xr.size());
+  if (sys.rows > 0 && dof > 0) {
+    const double rss = std::max(0.0, sys.ztz - xr.dot(sys.b));
+    Eigen::VectorXd e = Eigen::VectorXd::Zero(xr.size());
+    e(is) = 1.0;
+    const double inv_ss = sys.A.ldlt().solve(e)(is);
+    res.scale_relative_std = std::sqrt(std::max(0.0, rss / dof * inv_ss)) / xr(is);
+  }
+  if (o.max_scale_relative_std > 0.0 && !(res.scale_relative_std <= o.max_scale_relative_std)) {
+    res.reason = "alignment: scale " + std::to_string(s) + " too uncertain (relative std " +
+                 std::to_string(res.scale_relative_std) + ", need below " +
+                 std::to_string(o.max_scale_relative_std) + "): not enough accelerometer excitation";
     return res;
   }
   res.success = true;

@@ -21,6 +21,13 @@ struct VisualInertialAlignmentOptions {
   double gravity_norm = 9.81;            ///< known |g| [m/s^2]
   double max_gravity_norm_error = 1.0;   ///< the free-gravity solution must have ||g| - gravity_norm| below this
   int refinement_iterations = 4;         ///< tangent-sphere gravity refinements (VINS: 4)
+  /// The refined scale's standard deviation (from the least-squares residual and the normal matrix)
+  /// relative to the scale must stay below this: above it the window's motion did not excite the
+  /// accelerometer enough to tell the scale (constant velocity, or a constant acceleration that the free
+  /// gravity absorbs) and the noise picks it. Not in VINS (which accepts any s > 0). Loose on purpose:
+  /// the window solve refines a rough scale; on the simulated street (0.5 s windows) good windows read
+  /// 0.18-0.27 and degenerate ones 0.4-75. <= 0: no check.
+  double max_scale_relative_std = 0.3;
 };
 
 /// Result of alignVisualInertial().
@@ -30,6 +37,7 @@ struct VisualInertialAlignment {
   double scale = 0.0;                          ///< metric scale s: metric position = s * SfM position
   Eigen::Vector3d g_c0 = Eigen::Vector3d::Zero();   ///< gravity acceleration in c0, |g| = gravity_norm
   double free_gravity_norm = 0.0;              ///< |g| of the unconstrained solution (before refinement)
+  double scale_relative_std = 0.0;             ///< std(s) / s of the refined solution
   std::vector<Eigen::Vector3d> v_b;            ///< velocity of frame k expressed in body frame k [m/s]
 };
 
