@@ -6,6 +6,10 @@ function(dynavins_add_test)
     return()
   endif()
   cmake_parse_arguments(T "" "NAME" "SOURCES;LIBS;LABELS" ${ARGN})
+  # Heavy tests (long single-threaded renders) are not even built where they would not run (TSan pass).
+  if("heavy" IN_LIST T_LABELS AND NOT DYNAVINS_HEAVY_TESTS)
+    return()
+  endif()
   add_executable(${T_NAME} ${T_SOURCES})
   target_link_libraries(${T_NAME} PRIVATE dynavins_catch_main ${T_LIBS})
   target_compile_definitions(${T_NAME} PRIVATE
