@@ -196,8 +196,7 @@ TEST_CASE("SIGINT mid-run stops the replay cleanly", "[vio]") {
   fs::remove_all(dir);
 }
 
-// TODO(lead): enable once SlidingWindowEstimator tracks (the placeholder reports Initializing for every frame).
-TEST_CASE("odometry has one line per frame once the estimator tracks", "[vio][.needs-estimator]") {
+TEST_CASE("odometry has one line per frame once the estimator tracks", "[vio]") {
   const std::string dir = freshDir("odometry");
   int64_t first_tracking = -1, n = 0, tracking_after = 0;
   RunOutputs outputs(dir);
