@@ -335,8 +335,7 @@ WindowEstimate SlidingWindowEstimator::Impl::process(const TrackedFrame& frame, 
 
   if (!tracking) {
     if (mode.stereo) {
-      features.triangulate(cams(), T_c0c1, true);
-      if (newest > 0) pnpNewest();
+      if (newest > 0) pnpNewest();  // from points triangulated in earlier frames
       features.triangulate(cams(), T_c0c1, true);
     }
     if (newest < W) return finish(e);  // still filling the window
