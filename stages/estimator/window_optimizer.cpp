@@ -63,8 +63,10 @@ std::vector<VisualResidual> visualResiduals(WindowState& s, WindowFeature& f, co
 /// VINS-Fusion's loss: Huber with delta 1 (one noise sigma) on every visual residual in huber mode; in
 /// dynavins mode the weights replace it (eq. 4), and only the unweighted stereo residual keeps it.
 std::shared_ptr<ceres::LossFunction> lossFor(const VisualResidual& r, const WindowSolveOptions& o) {
+  // One stateless loss shared by every residual (Ceres does not own it here), not one per residual.
+  static const auto huber = std::make_shared<ceres::HuberLoss>(1.0);
   if (o.loss == BaLoss::Dynavins && r.weighted) return nullptr;
-  return std::make_shared<ceres::HuberLoss>(1.0);
+  return huber;
 }
 
 bool imuUsable(const WindowState& s, int k) { return s.preint[k] && s.preint[k]->sumDt() < 10.0; }
@@ -172,7 +174,6 @@ SolveStats WindowOptimizer::solve(WindowState& s, int newest, WindowFeatures& fe
   ceres::Problem problem(po);
   PoseManifold pose_manifold;
   std::vector<std::shared_ptr<ceres::CostFunction>> costs;  // alive until the problem goes
-  std::vector<std::shared_ptr<ceres::LossFunction>> losses;
 
   for (int k = 0; k <= newest; ++k) {
     problem.AddParameterBlock(s.pose[k].data(), kPoseSize, &pose_manifold);
@@ -200,7 +201,6 @@ SolveStats WindowOptimizer::solve(WindowState& s, int newest, WindowFeatures& fe
     in_ba.push_back(&f);
     for (VisualResidual& r : visualResiduals(s, f, opt_)) {
       auto loss = lossFor(r, opt_);
-      if (loss) losses.push_back(loss);
       costs.push_back(r.cost);
       problem.AddResidualBlock(r.cost.get(), loss.get(), r.blocks);
     }
