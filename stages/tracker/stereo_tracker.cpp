@@ -33,8 +33,10 @@ void compact(std::vector<T>* v, const std::vector<uchar>& keep) {
 StereoTracker::StereoTracker(const TrackerOptions& options, CameraModelPtr cam0, CameraModelPtr cam1)
     : opt_(options), cam0_(std::move(cam0)), cam1_(std::move(cam1)) {
   if (!cam0_) throw std::invalid_argument("StereoTracker: cam0 is required");
-  if (opt_.max_cnt <= 0 || opt_.min_dist < 0 || opt_.window < 3 || opt_.pyramid_levels < 0)
-    throw std::invalid_argument("StereoTracker: bad options (max_cnt > 0, min_dist >= 0, window >= 3, levels >= 0)");
+  if (opt_.max_cnt <= 0 || opt_.min_dist < 0 || opt_.window < 3 || opt_.pyramid_levels < 0 ||
+      opt_.stereo_retry_interval < 1)
+    throw std::invalid_argument(
+        "StereoTracker: bad options (max_cnt > 0, min_dist >= 0, window >= 3, levels >= 0, stereo_retry_interval >= 1)");
   if (opt_.clahe) clahe_ = cv::createCLAHE(opt_.clahe_clip, cv::Size(8, 8));
 }
 
@@ -203,6 +205,86 @@ void StereoTracker::enforce_spacing_and_detect(const cv::Mat& img, std::vector<T
   *prev_px = std::move(kept_prev);
 }
 
+void StereoTracker::match_stereo(const Pyramid& curr, const cv::Mat& right_in, std::vector<Track>* tracks,
+                                 TrackedFrame* out) const {
+  cv::Mat right = right_in;
+  const cv::Mat& left = curr[0];
+  if (right.size() != left.size()) throw std::invalid_argument("StereoTracker: left and right sizes differ");
+  if (opt_.stereo_gain_match) {
+    // KLT assumes equal brightness; the two sensors' exposure / gain differ (EuRoC: ~10 %), which
+    // pulls the left-right match off. One global gain brings the right image to the left's mean.
+    const double ml = cv::mean(left)[0], mr = cv::mean(right)[0];
+    if (mr > 1.0 && std::abs(ml / mr - 1.0) > 0.01) {
+      cv::Mat scaled;  // never in place: `right` may share the caller's pixels
+      right.convertTo(scaled, CV_8U, ml / mr);
+      right = scaled;
+    }
+  }
+  const Pyramid rpyr = pyramid(right);
+  const cv::Size win(opt_.window, opt_.window);
+  const cv::TermCriteria crit(cv::TermCriteria::COUNT | cv::TermCriteria::EPS, opt_.max_iterations, opt_.epsilon);
+  const std::size_t n = tracks->size();
+  std::vector<cv::Point2f> lpx(n), rpx(n), back;
+  std::vector<uchar> st(n, 0), back_st;
+  std::vector<float> err;
+  // Left -> right (no rectification, so no epipolar prior). A track matched in the last frame starts
+  // at its last disparity and needs only the fine levels; the rest, and the failures, search the
+  // whole pyramid from the left pixel.
+  // A track the right camera did not match waits stereo_retry_interval - 1 frames before searching
+  // again: features outside the overlap or on an occluded side keep failing, and a failing search
+  // costs the most (it runs to the iteration cap on every level).
+  std::vector<std::size_t> seeded, unseeded;
+  for (std::size_t i = 0; i < n; ++i) {
+    Track& t = (*tracks)[i];
+    lpx[i] = t.px;
+    if (!std::isnan(t.stereo_offset.x))
+      seeded.push_back(i);
+    else if (t.stereo_wait > 0)
+      --t.stereo_wait;
+    else
+      unseeded.push_back(i);
+  }
+  auto klt = [&](const std::vector<std::size_t>& idx, bool from_offset) {
+    if (idx.empty()) return;
+    std::vector<cv::Point2f> from(idx.size()), to(idx.size());
+    for (std::size_t k = 0; k < idx.size(); ++k) {
+      from[k] = lpx[idx[k]];
+      to[k] = from_offset ? from[k] + (*tracks)[idx[k]].stereo_offset : from[k];
+    }
+    std::vector<uchar> s;
+    cv::calcOpticalFlowPyrLK(curr, rpyr, from, to, s, err, win,
+                             from_offset ? std::min(1, opt_.pyramid_levels) : opt_.pyramid_levels, crit,
+                             from_offset ? cv::OPTFLOW_USE_INITIAL_FLOW : 0);
+    for (std::size_t k = 0; k < idx.size(); ++k) rpx[idx[k]] = to[k], st[idx[k]] = s[k];
+  };
+  klt(seeded, true);
+  for (std::size_t i : seeded)
+    if (!st[i]) unseeded.push_back(i);
+  klt(unseeded, false);
+  // Right -> left: a match that does not return to its start is ambiguous and left mono. The way back
+  // starts at the answer, so the fine levels suffice (as the temporal check).
+  back = lpx;
+  cv::calcOpticalFlowPyrLK(rpyr, curr, rpx, back, back_st, err, win, std::min(1, opt_.pyramid_levels), crit,
+                           cv::OPTFLOW_USE_INITIAL_FLOW);
+  for (std::size_t i = 0; i < n; ++i) {
+    Track& t = (*tracks)[i];
+    const bool searched = !std::isnan(t.stereo_offset.x) || t.stereo_wait == 0;
+    t.stereo_offset.x = std::numeric_limits<float>::quiet_NaN();
+    if (!searched) continue;  // waiting (see above)
+    if (!st[i] || !back_st[i] || !in_border(rpx[i], right.size()) || distance(back[i], lpx[i]) > opt_.max_back_error) {
+      t.stereo_wait = std::max(0, opt_.stereo_retry_interval - 1);
+      continue;
+    }
+    t.stereo_offset = rpx[i] - lpx[i];
+    TrackedFeature& f = out->features[i];
+    f.has_right = true;
+    f.px_right = to_eigen(rpx[i]);
+    f.bearing_right = cam1_->lift(f.px_right);
+    f.xy_right = f.bearing_right.head<2>() / f.bearing_right.z();
+    ++out->stats.stereo;
+  }
+}
+
 namespace {
 // Copies the simulator's label under each feature's rounded left pixel (for scoring only).
 void label_features(const cv::Mat& labels, std::vector<TrackedFeature>* features) {
@@ -245,44 +327,9 @@ TrackedFrame StereoTracker::process(const StereoFrame& frame, std::optional<Eige
   }
   if (!frame.labels.empty()) label_features(frame.labels, &out.features);
 
-  if (stereo && !tracks.empty()) {
-    cv::Mat right = prepare(frame.right);
-    if (right.size() != left.size()) throw std::invalid_argument("StereoTracker: left and right sizes differ");
-    if (opt_.stereo_gain_match) {
-      // KLT assumes equal brightness; the two sensors' exposure / gain differ (EuRoC: ~10 %), which
-      // pulls the left-right match off. One global gain brings the right image to the left's mean.
-      const double ml = cv::mean(left)[0], mr = cv::mean(right)[0];
-      if (mr > 1.0 && std::abs(ml / mr - 1.0) > 0.01) {
-        cv::Mat scaled;  // never in place: `right` may share the caller's pixels
-        right.convertTo(scaled, CV_8U, ml / mr);
-        right = scaled;
-      }
-    }
-    const Pyramid rpyr = pyramid(right);
-    const cv::Size win(opt_.window, opt_.window);
-    const cv::TermCriteria crit(cv::TermCriteria::COUNT | cv::TermCriteria::EPS, opt_.max_iterations, opt_.epsilon);
-    std::vector<cv::Point2f> lpx(tracks.size()), rpx, back;
-    for (std::size_t i = 0; i < tracks.size(); ++i) lpx[i] = tracks[i].px;
-    std::vector<uchar> st, back_st;
-    std::vector<float> err;
-    // Left -> right from the left pixel (no rectification, so no epipolar prior), then right ->
-    // left: a match that does not return to its start is ambiguous and left mono.
-    cv::calcOpticalFlowPyrLK(curr, rpyr, lpx, rpx, st, err, win, opt_.pyramid_levels, crit);
-    back = lpx;  // the way back starts at the answer, so the fine levels suffice (as the temporal check)
-    cv::calcOpticalFlowPyrLK(rpyr, curr, rpx, back, back_st, err, win, std::min(1, opt_.pyramid_levels), crit,
-                             cv::OPTFLOW_USE_INITIAL_FLOW);
-    for (std::size_t i = 0; i < tracks.size(); ++i) {
-      if (!st[i] || !back_st[i] || !in_border(rpx[i], right.size()) ||
-          distance(back[i], lpx[i]) > opt_.max_back_error)
-        continue;
-      TrackedFeature& f = out.features[i];
-      f.has_right = true;
-      f.px_right = to_eigen(rpx[i]);
-      f.bearing_right = cam1_->lift(f.px_right);
-      f.xy_right = f.bearing_right.head<2>() / f.bearing_right.z();
-      ++out.stats.stereo;
-    }
-  }
+  if (stereo && !tracks.empty()) match_stereo(curr, prepare(frame.right), &tracks, &out);
+  else
+    for (Track& t : tracks) t.stereo_offset.x = std::numeric_limits<float>::quiet_NaN();
 
   tracks_ = std::move(tracks);
   prev_pyr_ = std::move(curr);

@@ -4,6 +4,7 @@
 // longest tracks, left-to-right KLT with a reverse check for the stereo observation.
 // Moving objects are tracked like the rest: rejecting them is the estimator's job.
 
+#include <limits>
 #include <optional>
 #include <vector>
 
@@ -41,6 +42,10 @@ class StereoTracker {
     int length;
     cv::Point2f px;
     Eigen::Vector3d bearing;
+    /// Right pixel minus left pixel at the last stereo match (NaN when the last frame had none):
+    /// the disparity changes little between frames, so it seeds the next left-right KLT.
+    cv::Point2f stereo_offset{std::numeric_limits<float>::quiet_NaN(), 0.f};
+    int stereo_wait = 0;  ///< frames left before an unmatched track searches the right image again
   };
 
   cv::Mat prepare(const cv::Mat& img) const;
@@ -48,6 +53,7 @@ class StereoTracker {
   std::vector<Track> track_temporal(const Pyramid& curr, const std::optional<Eigen::Matrix3d>& R_prev_curr,
                                     std::vector<cv::Point2f>* prev_px, TrackerStats* stats) const;
   void reject_with_f(std::vector<Track>* tracks, std::vector<cv::Point2f>* prev_px, TrackerStats* stats) const;
+  void match_stereo(const Pyramid& left, const cv::Mat& right, std::vector<Track>* tracks, TrackedFrame* out) const;
   void enforce_spacing_and_detect(const cv::Mat& img, std::vector<Track>* tracks, std::vector<cv::Point2f>* prev_px,
                                   TrackerStats* stats);
   bool in_border(const cv::Point2f& p, const cv::Size& size) const;
