@@ -6,7 +6,7 @@ TSAN_BUILD ?= build-tsan
 CMAKE_GEN  := -G Ninja
 CTEST_J    ?= 2
 
-.PHONY: all deps build demo test test-unit test-tsan clean
+.PHONY: all deps build demo bench bench-quick test test-unit test-tsan clean
 
 all: build
 
@@ -30,6 +30,17 @@ demo: build
 	$(BUILD)/bin/dynavins compare runs/high-huber runs/high-dynavins --plot runs/high-compare.png
 	$(BUILD)/bin/dynavins overlay --euroc bench/cache/high/euroc --features runs/high-dynavins/features.csv --frames 4 --out runs/high-dynavins/overlay.png
 	@echo "demo: trajectories in runs/high-compare.png, weighted features in runs/high-dynavins/overlay.png"
+
+# The benchmark suite (scripts/bench.sh): every scenario generated once (cached in bench/cache/), the
+# estimator run on each stereo and mono, Huber and DynaVINS, plus the momentum ablation on `high`;
+# writes bench/results/REPORT.md with its figures and rewrites the README's headline table.
+# About 35 min on this 2-core machine. bench-quick: `none` and `high` cut to 20 s, a few minutes,
+# report in bench/results/quick/REPORT.md (the README is left alone).
+bench: build
+	DYNAVINS=$(BUILD)/bin/dynavins BENCH_TRACKER=$(BUILD)/bin/bench_tracker ./scripts/bench.sh
+
+bench-quick: build
+	DYNAVINS=$(BUILD)/bin/dynavins BENCH_TRACKER=$(BUILD)/bin/bench_tracker ./scripts/bench.sh --quick
 
 test: build
 	ctest --test-dir $(BUILD) --output-on-failure -j $(CTEST_J)

@@ -6,11 +6,13 @@
 # a cache made with it serves requests without it; a request with it regenerates a cache without it.
 # The scene is written to NAME.partial and swapped in only when complete.
 # DYNAVINS=path/to/dynavins picks the binary (default build/bin/dynavins).
+# CACHE_AS=DIRNAME caches under bench/cache/DIRNAME instead of bench/cache/NAME, so variants of one
+# scenario (e.g. CACHE_AS=high-20s with --duration 20, as `make bench-quick` does) do not evict each other.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 name=$1; shift
 bin=${DYNAVINS:-build/bin/dynavins}
-out=bench/cache/$name
+out=bench/cache/${CACHE_AS:-$name}
 want_euroc=0
 args=()
 for a in "$@"; do

@@ -133,6 +133,8 @@ void RunOutputs::check(std::ofstream& f, const std::string& name) const {
 void RunOutputs::write(const estimator::WindowEstimate& e) {
   ++totals_.estimates;
   if (e.status == estimator::EstimatorStatus::Reset) ++totals_.resets;
+  totals_.frame_ms.push_back(e.solve.total_ms);
+  if (e.solve.marginalization_ms > 0) totals_.marginalization_ms.push_back(e.solve.marginalization_ms);
   if (e.solve.alternations > 0) {
     totals_.ba_ms.push_back(e.solve.ba_ms);
     totals_.alternations.push_back(e.solve.alternations);
@@ -234,6 +236,9 @@ std::string summaryJson(const VioRunResult& run, const RunDescription& what, con
   j << "  \"ba_ms_max\": " << num(totals.ba_ms.empty() ? 0.0 : *std::max_element(totals.ba_ms.begin(), totals.ba_ms.end()))
     << ",\n";
   j << "  \"alternations_mean\": " << num(mean(alternations)) << ",\n";
+  j << "  \"estimator_frame_ms_mean\": " << num(mean(totals.frame_ms)) << ",\n";
+  j << "  \"estimator_frame_ms_p95\": " << num(percentile(totals.frame_ms, 95)) << ",\n";
+  j << "  \"marginalization_ms_mean\": " << num(mean(totals.marginalization_ms)) << ",\n";
   j << "  \"resets\": " << totals.resets << ",\n";
   j << "  \"estimator_events\": " << totals.events << ",\n";
   j << "  \"wall_s\": " << num(wall) << ",\n";

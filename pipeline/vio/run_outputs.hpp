@@ -33,6 +33,8 @@ struct EstimateTotals {
   int64_t estimates = 0, tracking = 0, resets = 0, events = 0, feature_rows = 0;
   std::vector<double> ba_ms;         ///< per estimate with alternations > 0
   std::vector<int> alternations;     ///< same estimates
+  std::vector<double> frame_ms;          ///< the estimator's whole time per frame (every estimate)
+  std::vector<double> marginalization_ms;  ///< per estimate that slid the window
 };
 
 /// Accuracy against ground truth, when there is one (absent: has_gt or evaluated false).

@@ -1,0 +1,164 @@
+#!/usr/bin/env bash
+# The benchmark suite (issue 6): generates the scenarios once (scripts/cached-sim.sh), runs the
+# estimator on each in every mode that matters, then writes the report (bench/report/make_report.py).
+# Usage: scripts/bench.sh [--quick] [--out DIR]
+#   full  (make bench):       every scenario of bench/scenarios at full length (40-85 s) -> bench/results/
+#   quick (make bench-quick): `none` and `high` cut to 20 s (cached as NAME-20s) -> bench/results/quick/
+# Every run: `dynavins run --rate 0 --set max_solver_time=1000` (lossless replay, solves bounded by
+# iterations only), so accuracy does not depend on machine load. A failed run is recorded as failed
+# (manifest + report) and the bench goes on; it exits 1 at the end when a scene or run crashed.
+# Only the full bench rewrites the README headline.
+# DYNAVINS=path/to/dynavins (default build/bin/dynavins); BENCH_TRACKER=path/to/bench_tracker
+# (default build/bin/bench_tracker; skipped when missing); PYTHON (default /usr/bin/python3).
+set -euo pipefail
+cd "$(dirname "$0")/.."
+
+quick=0
+out=""
+while [ $# -gt 0 ]; do
+  case $1 in
+    --quick) quick=1 ;;
+    --out) out=$2; shift ;;
+    -h|--help) sed -n '2,12p' "$0"; exit 0 ;;
+    *) echo "bench: unknown argument $1" >&2; exit 2 ;;
+  esac
+  shift
+done
+
+bin=${DYNAVINS:-build/bin/dynavins}
+tracker_bin=${BENCH_TRACKER:-build/bin/bench_tracker}
+python=${PYTHON:-/usr/bin/python3}
+[ -x "$bin" ] || { echo "bench: $bin not found (make build first)" >&2; exit 1; }
+
+if [ "$quick" = 1 ]; then
+  scenarios=(none high)
+  sim_args=(--duration 20)
+  suffix=-20s
+  out=${out:-bench/results/quick}
+else
+  scenarios=(none low mid high night dynamic_follow temporal_static e_shape)
+  sim_args=()
+  suffix=""
+  out=${out:-bench/results}
+fi
+ablation_scene=high
+overlay_scene=high
+
+mkdir -p "$out"
+rm -rf "$out/runs"
+mkdir -p "$out/runs"
+manifest=$out/manifest.tsv
+meta=$out/meta.tsv
+
+# --- what was run, where, on what -------------------------------------------------------------
+commit=$(git rev-parse HEAD 2>/dev/null || echo unknown)
+dirty=clean
+[ -n "$(git status --porcelain --untracked-files=no 2>/dev/null)" ] && dirty=dirty
+cpu=$(grep -m1 'model name' /proc/cpuinfo | cut -d: -f2- | sed 's/^ *//')
+ram_gb=$(awk '/MemTotal/ {printf "%.1f", $2/1048576}' /proc/meminfo)
+{
+  printf 'mode\t%s\n' "$([ "$quick" = 1 ] && echo quick || echo full)"
+  printf 'commit\t%s\n' "$commit"
+  printf 'dirty\t%s\n' "$dirty"
+  printf 'date\t%s\n' "$(date -u +%Y-%m-%dT%H:%M:%SZ)"
+  printf 'nproc\t%s\n' "$(nproc)"
+  printf 'cpu\t%s\n' "$cpu"
+  printf 'ram_gb\t%s\n' "$ram_gb"
+  printf 'binary\t%s\n' "$bin"
+  printf 'bench_command\t%s\n' "scripts/bench.sh$([ "$quick" = 1 ] && echo ' --quick') --out $out"
+  printf 'sim_args\t%s\n' "${sim_args[*]:-}"
+} > "$meta"
+printf 'kind\tscenario\tmode\tba\tvariant\tstatus\twall_s\tdir\tcommand\n' > "$manifest"
+
+# --- progress ---------------------------------------------------------------------------------
+runs_per_scene=4
+total=$(( ${#scenarios[@]} * (1 + runs_per_scene) + 1 + 1 ))  # scenes x (generate + runs), ablation, overlay
+[ -x "$tracker_bin" ] && total=$((total + 1))
+step=0
+bench_start=$(date +%s)
+
+# record KIND SCENARIO MODE BA VARIANT STATUS WALL DIR COMMAND
+record() { local IFS=$'\t'; echo "$*" >> "$manifest"; }
+
+# timed LABEL LOGFILE CMD...: runs CMD with output to LOGFILE, prints a progress line, sets $status
+# (ok, cached: a scene reused by cached-sim.sh, exitN) and $wall
+timed() {
+  local label=$1 log=$2; shift 2
+  step=$((step + 1))
+  printf '[%d/%d] %s ... ' "$step" "$total" "$label"
+  local t0; t0=$(date +%s.%N)
+  if "$@" > "$log" 2>&1; then status=ok; else status="exit$?"; fi
+  [ "$status" = ok ] && grep -q 'cached-sim: .* is up to date' "$log" && status=cached
+  wall=$(awk -v a="$t0" -v b="$(date +%s.%N)" 'BEGIN {printf "%.1f", b - a}')
+  printf '%s s (%s)\n' "$wall" "$status"
+}
+
+# run_one SCENARIO MODE BA [VARIANT --set k=v ...]
+run_one() {
+  local sc=$1 mode=$2 ba=$3; shift 3
+  local variant=${1:-}; [ $# -gt 0 ] && shift
+  local data=bench/cache/$sc$suffix/euroc
+  local dir=$out/runs/$sc/$mode-$ba${variant:+-$variant}
+  local cmd=("$bin" run --config "$data/vins_config.yaml" --euroc "$data" --ba "$ba" --rate 0
+             --set max_solver_time=1000 "$@" --out "$dir")
+  [ "$mode" = mono ] && cmd+=(--mono)
+  mkdir -p "$dir"
+  timed "$sc $mode $ba${variant:+ ($variant)}" "$dir/run.log" timeout 1800 "${cmd[@]}"
+  record run "$sc" "$mode" "$ba" "${variant:--}" "$status" "$wall" "$dir" "${cmd[*]}"
+}
+
+for sc in "${scenarios[@]}"; do
+  gen=(env CACHE_AS="$sc$suffix" DYNAVINS="$bin" scripts/cached-sim.sh "$sc" "${sim_args[@]}" --euroc)
+  timed "generate $sc$suffix" "$out/runs/generate-$sc.log" "${gen[@]}"
+  record generate "$sc" - - - "$status" "$wall" "bench/cache/$sc$suffix" "${gen[*]}"
+  if [ "$status" != ok ] && [ "$status" != cached ]; then
+    echo "bench: generating $sc failed (see $out/runs/generate-$sc.log); its runs are recorded as failed" >&2
+    for mode in stereo mono; do for ba in huber dynavins; do
+      step=$((step + 1))
+      record run "$sc" "$mode" "$ba" - "no-data" 0 "$out/runs/$sc/$mode-$ba" "(scene not generated)"
+    done; done
+    if [ "$sc" = "$ablation_scene" ]; then
+      step=$((step + 1))
+      record run "$sc" stereo dynavins nomomentum "no-data" 0 "$out/runs/$sc/stereo-dynavins-nomomentum" "(scene not generated)"
+    fi
+    continue
+  fi
+  for mode in stereo mono; do
+    for ba in huber dynavins; do
+      run_one "$sc" "$mode" "$ba"
+    done
+  done
+  if [ "$sc" = "$ablation_scene" ]; then
+    # Table I: regularisation only (the paper's λm = 0 ablation)
+    run_one "$sc" stereo dynavins nomomentum --set momentum_on=0
+  fi
+done
+
+# --- a feature-weight overlay from the DynaVINS stereo run on `high` ---------------------------
+ov=("$bin" overlay --euroc "bench/cache/$overlay_scene$suffix/euroc"
+    --features "$out/runs/$overlay_scene/stereo-dynavins/features.csv" --frames 2 --scale 0.6
+    --out "$out/overlay_$overlay_scene.png")
+timed "overlay $overlay_scene" "$out/runs/overlay.log" "${ov[@]}"
+record overlay "$overlay_scene" stereo dynavins - "$status" "$wall" "$out/overlay_$overlay_scene.png" "${ov[*]}"
+
+# --- tracker alone on one core (sim + the real EuRoC clip) -------------------------------------
+if [ -x "$tracker_bin" ]; then
+  timed "bench_tracker" "$out/bench_tracker.txt" "$tracker_bin"
+  record bench_tracker - - - - "$status" "$wall" "$out/bench_tracker.txt" "$tracker_bin"
+fi
+
+printf 'bench_wall_s\t%s\n' "$(( $(date +%s) - bench_start ))" >> "$meta"
+
+report=("$python" bench/report/make_report.py --results "$out")
+[ "$quick" = 0 ] && report+=(--readme README.md)
+printf 'report_command\t%s\n' "${report[*]}" >> "$meta"
+"${report[@]}"
+
+# Crashes (a scene not generated, a run or the overlay exiting non-zero) fail the bench once the
+# report is written; lost or diverged estimates are results, not errors.
+crashed=$(awk -F'\t' 'NR > 1 && $6 != "ok" && $6 != "cached"' "$manifest" | wc -l)
+if [ "$crashed" -gt 0 ]; then
+  echo "bench: $crashed step(s) failed (status column of $manifest); the report shows them" >&2
+  exit 1
+fi
+echo "bench: report in $out/REPORT.md"
