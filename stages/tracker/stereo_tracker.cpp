@@ -234,15 +234,18 @@ void StereoTracker::match_stereo(const Pyramid& curr, const cv::Mat& right_in, s
   // again: features outside the overlap or on an occluded side keep failing, and a failing search
   // costs the most (it runs to the iteration cap on every level).
   std::vector<std::size_t> seeded, unseeded;
+  std::vector<uchar> searched(n, 1);
   for (std::size_t i = 0; i < n; ++i) {
     Track& t = (*tracks)[i];
     lpx[i] = t.px;
-    if (!std::isnan(t.stereo_offset.x))
+    if (!std::isnan(t.stereo_offset.x)) {
       seeded.push_back(i);
-    else if (t.stereo_wait > 0)
+    } else if (t.stereo_wait > 0) {
       --t.stereo_wait;
-    else
+      searched[i] = 0;
+    } else {
       unseeded.push_back(i);
+    }
   }
   auto klt = [&](const std::vector<std::size_t>& idx, bool from_offset) {
     if (idx.empty()) return;
@@ -268,9 +271,8 @@ void StereoTracker::match_stereo(const Pyramid& curr, const cv::Mat& right_in, s
                            cv::OPTFLOW_USE_INITIAL_FLOW);
   for (std::size_t i = 0; i < n; ++i) {
     Track& t = (*tracks)[i];
-    const bool searched = !std::isnan(t.stereo_offset.x) || t.stereo_wait == 0;
     t.stereo_offset.x = std::numeric_limits<float>::quiet_NaN();
-    if (!searched) continue;  // waiting (see above)
+    if (!searched[i]) continue;  // waiting (see above)
     if (!st[i] || !back_st[i] || !in_border(rpx[i], right.size()) || distance(back[i], lpx[i]) > opt_.max_back_error) {
       t.stereo_wait = std::max(0, opt_.stereo_retry_interval - 1);
       continue;
