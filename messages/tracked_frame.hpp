@@ -30,6 +30,8 @@ struct TrackerStats {
   int tracked = 0;        ///< features carried over from the previous frame
   int lost_flow = 0;      ///< KLT failed or left the image
   int lost_back = 0;      ///< failed the forward-backward check
+  int lost_patch = 0;     ///< its first patch aligned away from the KLT answer (patch_refine)
+  int patch_recaptured = 0;  ///< first patch taken again: it no longer aligned, or changed size
   int lost_ransac = 0;    ///< rejected by the fundamental-matrix RANSAC (off by default)
   int lost_mask = 0;      ///< dropped for crowding a longer track (min_dist)
   int detected = 0;       ///< new corners

@@ -78,6 +78,7 @@ EstimatorOptions EstimatorOptions::load(const std::string& path) {
   l.opt("F_threshold", o.F_threshold);
   l.opt("show_track", o.show_track);
   l.opt("flow_back", o.flow_back);
+  l.opt("patch_refine", o.patch_refine);
   l.opt("max_solver_time", o.max_solver_time);
   l.opt("max_num_iterations", o.max_num_iterations);
   l.opt("keyframe_parallax", o.keyframe_parallax);
@@ -143,6 +144,7 @@ std::string EstimatorOptions::print() const {
   line("F_threshold", F_threshold);
   line("show_track", show_track);
   line("flow_back", flow_back);
+  line("patch_refine", patch_refine);
   line("max_solver_time", max_solver_time, " [s]");
   line("max_num_iterations", max_num_iterations);
   line("keyframe_parallax", keyframe_parallax);
@@ -256,6 +258,7 @@ void EstimatorOptions::apply(const std::string& key, const std::string& value) {
       {"F_threshold", real_in(&EstimatorOptions::F_threshold, 0, inf, true, "must be positive")},
       {"show_track", flag(&EstimatorOptions::show_track)},
       {"flow_back", flag(&EstimatorOptions::flow_back)},
+      {"patch_refine", flag(&EstimatorOptions::patch_refine)},
       {"max_solver_time", real_in(&EstimatorOptions::max_solver_time, 0, inf, true, "must be positive [s]")},
       {"max_num_iterations", positive_int(&EstimatorOptions::max_num_iterations)},
       {"keyframe_parallax", real_in(&EstimatorOptions::keyframe_parallax, 0, inf, true, "must be positive")},

@@ -42,6 +42,9 @@ struct EstimatorOptions {
   double F_threshold = 1.0;
   bool show_track = false;
   bool flow_back = true;
+  /// Ours, not VINS-Fusion's: align each track's first patch after the KLT (tracker_options.hpp); 0 gives
+  /// VINS-Fusion's plain frame-to-frame KLT.
+  bool patch_refine = true;
 
   // Optimization.
   double max_solver_time = 0.04;  ///< seconds

@@ -84,7 +84,7 @@ std::vector<StereoTracker::Track> StereoTracker::track_temporal(const Pyramid& c
   std::vector<uchar> status(n, 0), predicted(n, 0);
   std::vector<float> err;
   if (R_prev_curr) {
-    // A pure rotation moves every pixel the same whatever its depth: a good start for the fine levels.
+    // A pure rotation moves every pixel the same whatever its depth: a good start.
     const Eigen::Matrix3d R_curr_prev = R_prev_curr->transpose();
     for (std::size_t i = 0; i < n; ++i) {
       const Eigen::Vector3d b = R_curr_prev * tracks[i].bearing;
@@ -95,7 +95,9 @@ std::vector<StereoTracker::Track> StereoTracker::track_temporal(const Pyramid& c
       px[i] = g;
       predicted[i] = 1;
     }
-    cv::calcOpticalFlowPyrLK(prev_pyr_, curr, *prev_px, px, status, err, win, std::min(1, opt_.pyramid_levels), crit,
+    // The whole pyramid from the prediction: the fine levels alone lose fast-moving objects, whose
+    // image motion the camera's rotation does not explain.
+    cv::calcOpticalFlowPyrLK(prev_pyr_, curr, *prev_px, px, status, err, win, opt_.pyramid_levels, crit,
                              cv::OPTFLOW_USE_INITIAL_FLOW);
     // Retry the failures (and the unpredicted) from scratch with the whole pyramid.
     std::vector<std::size_t> redo;
@@ -142,6 +144,41 @@ std::vector<StereoTracker::Track> StereoTracker::track_temporal(const Pyramid& c
   compact(prev_px, status);
   for (auto& t : tracks) t.bearing = cam0_->lift(to_eigen(t.px));
   return tracks;
+}
+
+void StereoTracker::refine_with_patches(const cv::Mat& img, std::vector<Track>* tracks,
+                                        std::vector<cv::Point2f>* prev_px, TrackerStats* stats) const {
+  std::vector<uchar> keep(tracks->size(), 1);
+  const float noise_sigma = imageNoiseSigma(img);
+  for (std::size_t i = 0; i < tracks->size(); ++i) {
+    Track& t = (*tracks)[i];
+    if (!t.patch) continue;
+    AffineWarp w = t.warp;
+    w.t = Eigen::Vector2f(t.px.x, t.px.y);
+    const RefineOutcome o = refinePatch(*t.patch, img, &w, noise_sigma);
+    const RefineResult r = o.result;
+    if (r == RefineResult::OutOfImage) continue;  // near the border: keep the KLT answer as it is
+    const cv::Point2f refined(w.t.x(), w.t.y());
+    if (r == RefineResult::Diverged || distance(refined, t.px) > opt_.patch_max_shift ||
+        !in_border(refined, img.size())) {
+      // The first patch no longer settles (its look changed beyond an affine warp: occluded, seen from
+      // too far round) or settles elsewhere (the KLT slid): the track cannot be trusted any longer.
+      keep[i] = 0;
+      ++stats->lost_patch;
+      continue;
+    }
+    t.px = refined;
+    t.bearing = cam0_->lift(to_eigen(t.px));
+    t.warp = w;
+    const double s = w.scale();
+    if (s > opt_.patch_recapture_scale || s < 1.0 / opt_.patch_recapture_scale) {
+      t.patch = capturePatch(img, w.t);
+      t.warp = AffineWarp{};
+      ++stats->patch_recaptured;
+    }
+  }
+  compact(tracks, keep);
+  compact(prev_px, keep);
 }
 
 void StereoTracker::reject_with_f(std::vector<Track>* tracks, std::vector<cv::Point2f>* prev_px,
@@ -197,6 +234,7 @@ void StereoTracker::enforce_spacing_and_detect(const cv::Mat& img, std::vector<T
     for (const auto& c : corners) {
       if (!in_border(c, img.size())) continue;
       kept.push_back(Track{next_id_++, 1, c, cam0_->lift(to_eigen(c))});
+      if (opt_.patch_refine) kept.back().patch = capturePatch(img, Eigen::Vector2f(c.x, c.y));
       kept_prev.emplace_back(std::numeric_limits<float>::quiet_NaN(), 0.f);  // new: no velocity
       ++stats->detected;
     }
@@ -312,6 +350,7 @@ TrackedFrame StereoTracker::process(const StereoFrame& frame, std::optional<Eige
   Pyramid curr = pyramid(left);
   std::vector<cv::Point2f> prev_px;
   std::vector<Track> tracks = track_temporal(curr, R_prev_curr_cam0, &prev_px, &out.stats);
+  if (opt_.patch_refine) refine_with_patches(left, &tracks, &prev_px, &out.stats);
   if (opt_.f_ransac) reject_with_f(&tracks, &prev_px, &out.stats);
   enforce_spacing_and_detect(left, &tracks, &prev_px, &out.stats);
 

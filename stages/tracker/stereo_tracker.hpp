@@ -15,6 +15,7 @@
 #include "messages/sensor_messages.hpp"
 #include "messages/tracked_frame.hpp"
 #include "stages/common/camera_model.hpp"
+#include "stages/tracker/patch_template.hpp"
 #include "stages/tracker/tracker_options.hpp"
 
 namespace dynavins {
@@ -46,12 +47,16 @@ class StereoTracker {
     /// the disparity changes little between frames, so it seeds the next left-right KLT.
     cv::Point2f stereo_offset{std::numeric_limits<float>::quiet_NaN(), 0.f};
     int stereo_wait = 0;  ///< frames left before an unmatched track searches the right image again
+    std::shared_ptr<const PatchTemplate> patch;  ///< first appearance (null: no refinement)
+    AffineWarp warp;                              ///< where `patch` lay in the last frame
   };
 
   cv::Mat prepare(const cv::Mat& img) const;
   Pyramid pyramid(const cv::Mat& img) const;
   std::vector<Track> track_temporal(const Pyramid& curr, const std::optional<Eigen::Matrix3d>& R_prev_curr,
                                     std::vector<cv::Point2f>* prev_px, TrackerStats* stats) const;
+  void refine_with_patches(const cv::Mat& img, std::vector<Track>* tracks, std::vector<cv::Point2f>* prev_px,
+                           TrackerStats* stats) const;
   void reject_with_f(std::vector<Track>* tracks, std::vector<cv::Point2f>* prev_px, TrackerStats* stats) const;
   void match_stereo(const Pyramid& left, const cv::Mat& right, std::vector<Track>* tracks, TrackedFrame* out) const;
   void enforce_spacing_and_detect(const cv::Mat& img, std::vector<Track>* tracks, std::vector<cv::Point2f>* prev_px,

@@ -20,6 +20,15 @@ struct TrackerOptions {
   /// A track without a right match searches again only every this many frames (1: every frame). On
   /// the EuRoC clip 4 keeps the stereo match rate (0.51 either way) and runs a failing search a quarter as often.
   int stereo_retry_interval = 4;
+  /// Align each track's first patch (affine warp, gain / offset) after the KLT and move the track onto
+  /// it: frame-to-frame KLT drifts, the first patch does not (patch_template.hpp).
+  bool patch_refine = true;
+  /// [px] a refinement landing farther than this from the KLT answer means the two disagree on what
+  /// the feature is: the track ends. Generous: on a healthy track the two differ by ~0.3 px.
+  double patch_max_shift = 2.0;
+  /// The patch is captured again at the refined pixel when its apparent size has changed by more than
+  /// this factor (the affine model of a plane patch is only local).
+  double patch_recapture_scale = 1.5;
   int pyramid_levels = 3;  ///< maxLevel of the pyramids (levels above the full image)
   int window = 21;         ///< [px] KLT window side
   int max_iterations = 30;
@@ -33,6 +42,7 @@ struct TrackerOptions {
     t.max_cnt = o.max_cnt;
     t.min_dist = o.min_dist;
     t.flow_back = o.flow_back;
+    t.patch_refine = o.patch_refine;
     t.f_threshold = o.F_threshold;
     return t;
   }

@@ -158,7 +158,7 @@ TEST_CASE("print() lists every effective option with its source", "[options]") {
   const auto o = EstimatorOptions::load(kViode + "calibration_stereo.yaml");
   const std::string p = o.print();
   for (const char* key : {"imu", "num_of_cam", "cam0_calib", "cam1_calib", "body_T_cam0", "body_T_cam1", "image_width",
-                          "image_height", "max_cnt", "min_dist", "freq", "F_threshold", "flow_back", "show_track",
+                          "image_height", "max_cnt", "min_dist", "freq", "F_threshold", "flow_back", "patch_refine", "show_track",
                           "max_solver_time", "max_num_iterations", "keyframe_parallax", "acc_n", "gyr_n", "acc_w",
                           "gyr_w", "g_norm", "estimate_td", "td", "estimate_extrinsic", "regularization_lambda",
                           "lambda_w", "momentum_lambda", "alternating_converge", "margin_feature_thresh",

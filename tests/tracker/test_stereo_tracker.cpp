@@ -69,15 +69,16 @@ struct Truth {
 };
 
 struct SimRun {
-  std::vector<TrackedFrame> plain, predicted, ransac;
-  std::vector<std::vector<Truth>> truth_plain, truth_predicted, truth_ransac;
+  std::vector<TrackedFrame> plain, predicted, ransac, klt_only;
+  std::vector<std::vector<Truth>> truth_plain, truth_predicted, truth_ransac, truth_klt_only;
   std::vector<Eigen::Isometry3d> T_world_cam0;
   sim::StereoRig rig;
   CameraModelPtr cam;
 };
 
-/// 2.5 s along a short avenue; a truck crosses 7 m ahead at t = 1.2 s. Tracked twice, without and
-/// with the gyro prediction (true relative rotation), in one pass over the rendered frames.
+/// 2.5 s along a short avenue; a truck crosses 7 m ahead at t = 1.2 s. Tracked without and with the
+/// gyro prediction (true relative rotation), with F-RANSAC, and without the first-patch refinement
+/// (plain KLT), in one pass over the rendered frames.
 const SimRun& sim_run() {
   static const SimRun run = [] {
     const fs::path dir = fs::temp_directory_path() / "dynavins_test_tracker";
@@ -92,10 +93,11 @@ const SimRun& sim_run() {
     SimRun r;
     r.rig = scenario->rig;
     r.cam = camera_of(r.rig.camera);
-    TrackerOptions with_f;
+    TrackerOptions with_f, no_patch;
     with_f.f_ransac = true;
+    no_patch.patch_refine = false;
     StereoTracker plain(TrackerOptions{}, r.cam, r.cam), predicted(TrackerOptions{}, r.cam, r.cam),
-        ransac(with_f, r.cam, r.cam);
+        ransac(with_f, r.cam, r.cam), klt_only(no_patch, r.cam, r.cam);
     SensorEvent e;
     while (src.next(e)) {
       const auto* f = std::get_if<StereoFrame>(&e);
@@ -108,8 +110,9 @@ const SimRun& sim_run() {
       r.plain.push_back(plain.process(*f));
       r.predicted.push_back(predicted.process(*f, R));
       r.ransac.push_back(ransac.process(*f));
+      r.klt_only.push_back(klt_only.process(*f));
       for (auto [out, truth] : {std::pair{&r.plain, &r.truth_plain}, std::pair{&r.predicted, &r.truth_predicted},
-                                std::pair{&r.ransac, &r.truth_ransac}}) {
+                                std::pair{&r.ransac, &r.truth_ransac}, std::pair{&r.klt_only, &r.truth_klt_only}}) {
         truth->emplace_back();
         for (const auto& ft : out->back().features)
           truth->back().push_back({true_depth(src.last_left().depth, ft.px), label_at(f->labels, ft.px)});
@@ -166,7 +169,7 @@ TEST_CASE("StereoTracker: ids stay on the same 3-D point (true depth and pose)",
     std::printf("identity (prediction %d): %zu observations, median %.3f px, p95 %.3f px, max %.3f px\n",
                 with_prediction, err.size(), quantile(err, 0.5), quantile(err, 0.95), quantile(err, 1.0));
     CHECK(err.size() > 1000);
-    // KLT localises a corner to ~0.1 px per frame and the error random-walks along the track;
+    // A corner is localised to ~0.1 px (the first-patch refinement keeps it from random-walking);
     // a feature that jumped to another corner is off by the corner spacing (>= min_dist = 30 px).
     CHECK(quantile(err, 0.5) < 0.5);
     CHECK(quantile(err, 0.99) < 3.0);
@@ -174,6 +177,22 @@ TEST_CASE("StereoTracker: ids stay on the same 3-D point (true depth and pose)",
   int predicted = 0;
   for (const auto& f : r.predicted) predicted += f.stats.predicted;
   CHECK(predicted > 0);
+}
+
+TEST_CASE("StereoTracker: the first-patch refinement keeps tracks nearer their point than plain KLT", "[tracker]") {
+  const SimRun& r = sim_run();
+  const auto refined = identity_errors(r.plain, r.truth_plain, r);
+  const auto klt = identity_errors(r.klt_only, r.truth_klt_only, r);
+  std::printf("identity, refined: median %.3f p90 %.3f px; plain KLT: median %.3f p90 %.3f px\n", quantile(refined, 0.5),
+              quantile(refined, 0.9), quantile(klt, 0.5), quantile(klt, 0.9));
+  // Frame-to-frame KLT errors add up along a track; the first patch does not move. The gain is in the
+  // tail (the long tracks): on these 2.5 s the typical track is young, and both localise it to < 0.1 px
+  // (measured when written: median 0.064 vs 0.041, p90 0.225 vs 0.397 px).
+  CHECK(quantile(refined, 0.5) < 0.1);
+  CHECK(quantile(refined, 0.9) < 0.8 * quantile(klt, 0.9));
+  int lost = 0, tracked = 0;
+  for (const auto& f : r.plain) lost += f.stats.lost_patch, tracked += f.stats.tracked;
+  CHECK(lost < 0.05 * tracked);  // ends few tracks
 }
 
 TEST_CASE("StereoTracker: stereo depth within a pixel of disparity of the true depth", "[tracker]") {
