@@ -1,6 +1,6 @@
 // `dynavins run --config FILE.yaml (--euroc DIR | --log FILE | --rosbag FILE) [--rate R] [--out DIR]
-//  [--ba huber|dynavins] [--mono] [--set key=value ...]`: the whole visual-inertial pipeline on a
-// recording; writes odometry, weighted features, events and summary.json into --out.
+//  [--ba huber|dynavins] [--mono] [--gyro-prediction] [--set key=value ...]`: the whole
+// visual-inertial pipeline on a recording; writes odometry, weighted features, events and summary.json into --out.
 #include <cstdio>
 #include <filesystem>
 #include <memory>
@@ -33,6 +33,7 @@ struct RunCommandOptions {
   bool mono = false;
   std::vector<std::string> set;
   double imu_rate_hz = 200.0;
+  bool gyro_prediction = false;
 };
 
 std::string inputName(const SensorInput& in) {
@@ -62,6 +63,7 @@ void run(const RunCommandOptions& o) {
   opt.mode.stereo = !o.mono;
   opt.rate = o.rate;
   opt.imu_rate_hz = o.imu_rate_hz;
+  opt.gyro_prediction = o.gyro_prediction;
   try {
     pipeline::checkVioOptions(opt);
   } catch (const std::invalid_argument& e) {
@@ -76,8 +78,9 @@ void run(const RunCommandOptions& o) {
   what.stereo = opt.mode.stereo;
   what.rate = o.rate;
   const std::string out_dir = o.out.empty() ? "runs/" + inputName(o.input) + "-" + what.ba_loss : o.out;
-  spdlog::info("run: {} BA, {}, rate {} -> {}", what.ba_loss, what.stereo ? "stereo" : "mono",
-               o.rate > 0 ? fmt::format("{}x real time", o.rate) : std::string("as fast as possible"), out_dir);
+  spdlog::info("run: {} BA, {}, rate {}, gyro-predicted KLT {} -> {}", what.ba_loss, what.stereo ? "stereo" : "mono",
+               o.rate > 0 ? fmt::format("{}x real time", o.rate) : std::string("as fast as possible"),
+               opt.gyro_prediction ? "on" : "off", out_dir);
 
   auto source = o.input.open();
   std::unique_ptr<pipeline::RunOutputs> outputs;
@@ -109,6 +112,11 @@ void run(const RunCommandOptions& o) {
               static_cast<long long>(r.frames_dropped), static_cast<long long>(t.estimates),
               static_cast<long long>(t.tracking), t.estimates ? 100.0 * t.tracking / t.estimates : 0.0,
               r.interrupted() ? "  (interrupted)" : "");
+  if (r.gyro_prediction)
+    std::printf("gyro KLT    %lld frames predicted, %lld not (first, after a drop or an IMU gap); %lld KLT from the "
+                "prediction, %lld tracks carried over\n",
+                static_cast<long long>(r.frames_gyro_predicted), static_cast<long long>(r.frames_gyro_unpredicted),
+                static_cast<long long>(r.features_gyro_predicted), static_cast<long long>(r.features_tracked));
   if (!t.ba_ms.empty()) {
     double sum = 0, mx = 0;
     for (double x : t.ba_ms) sum += x, mx = std::max(mx, x);
@@ -141,6 +149,9 @@ void add_run_command(CLI::App& app) {
       ->check(CLI::IsMember({"huber", "dynavins"}))
       ->capture_default_str();
   cmd->add_flag("--mono", o->mono, "Use cam0 only");
+  cmd->add_flag("--gyro-prediction", o->gyro_prediction,
+                "Seed the tracker's KLT with the gyro-integrated rotation (bias from the estimator; the run then "
+                "depends on thread timing and is not bit-repeatable)");
   cmd->add_option("--set", o->set, "Override a yaml option: --set key=value (repeatable)");
   cmd->add_option("--imu-rate", o->imu_rate_hz, "Nominal IMU rate [Hz], for IMU gap detection")
       ->check(CLI::Range(1.0, 100000.0))

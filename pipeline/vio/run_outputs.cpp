@@ -223,6 +223,13 @@ std::string summaryJson(const VioRunResult& run, const RunDescription& what, con
   j << "  \"imu_intervals\": " << run.imu.intervals << ",\n";
   j << "  \"imu_intervals_with_gap\": " << run.imu_builder.intervals_with_gap << ",\n";
   j << "  \"ground_truth_states\": " << run.ground_truth.size() << ",\n";
+  j << "  \"tracker\": {\"gyro_prediction\": " << (run.gyro_prediction ? "true" : "false")
+    << ", \"frames_gyro_predicted\": " << run.frames_gyro_predicted
+    << ", \"frames_gyro_unpredicted\": " << run.frames_gyro_unpredicted
+    << ", \"features_tracked\": " << run.features_tracked
+    << ", \"features_gyro_predicted\": " << run.features_gyro_predicted
+    << ", \"features_lost_flow\": " << run.features_lost_flow
+    << ", \"features_lost_back\": " << run.features_lost_back << "},\n";
   j << "  \"stage_ms\": {";
   for (std::size_t i = 0; i < run.report.stages.size(); ++i) {
     const StageStats& s = run.report.stages[i];

@@ -4,7 +4,8 @@
 //   features.csv          the window's features with their robust-BA weights, per Tracking estimate
 //   estimator_events.csv  t_ns, seq, event for every estimate with a non-empty event
 //   groundtruth.tum       the source's ground truth, when it has one
-//   summary.json          counts, per-stage timing, BA cost, real-time factor, memory, ATE when known
+//   summary.json          counts, per-stage timing, tracker gyro prediction, BA cost, real-time factor, memory,
+//                         ATE when known
 // Everything is written under a `.partial` name and renamed only by complete(): a failed or killed run
 // leaves no file that looks finished.
 

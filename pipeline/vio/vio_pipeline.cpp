@@ -1,5 +1,7 @@
 #include "pipeline/vio/vio_pipeline.hpp"
 
+#include <cmath>
+#include <optional>
 #include <stdexcept>
 #include <utility>
 #include <variant>
@@ -8,7 +10,9 @@
 
 #include "pipeline/emit.hpp"
 #include "pipeline/latest_value.hpp"
+#include "pipeline/vio/frame_imu_attacher.hpp"
 #include "stages/estimator/estimator_input.hpp"
+#include "stages/tracker/gyro_rotation_predictor.hpp"
 #include "stages/tracker/stereo_tracker.hpp"
 
 namespace dynavins::pipeline {
@@ -17,13 +21,38 @@ namespace {
 using estimator::EstimatorInput;
 using estimator::WindowEstimate;
 
-/// Tracker thread: the KLT front end; in mono mode the right image is ignored.
+/// Tracker thread: the KLT front end; in mono mode the right image is ignored. With a predictor, each
+/// frame's KLT starts from the rotation its gyro samples give since the previous tracked frame.
 struct TrackerStage {
+  TrackerStage(StereoTracker t, bool mono_, std::optional<GyroRotationPredictor> g, LatestValue<Eigen::Vector3d>& b)
+      : tracker(std::move(t)), mono(mono_), gyro(std::move(g)), gyro_bias(b) {}
+
   StereoTracker tracker;
   bool mono;
-  TrackedFrame process(StereoFrame frame) {
-    if (mono) frame.right = cv::Mat();
-    return tracker.process(frame);
+  std::optional<GyroRotationPredictor> gyro;  ///< empty: prediction off
+  /// The estimator's newest gyro bias. A LatestValue has one reader and the IMU thread reads the
+  /// NavState one, so the estimator publishes the bias a second time, for this thread alone.
+  LatestValue<Eigen::Vector3d>& gyro_bias;
+  Eigen::Vector3d bias = Eigen::Vector3d::Zero();  // zero until the estimator tracks
+  std::optional<int64_t> prev_t_ns;
+  int64_t frames_predicted = 0, frames_unpredicted = 0, features_predicted = 0, features_tracked = 0;
+  int64_t features_lost_flow = 0, features_lost_back = 0;
+
+  TrackedFrame process(TrackerInput in) {
+    if (mono) in.frame.right = cv::Mat();
+    std::optional<Eigen::Matrix3d> R_prev_curr;
+    if (gyro) {
+      if (const auto b = gyro_bias.read()) bias = *b;
+      if (prev_t_ns) R_prev_curr = gyro->predict(in.imu, *prev_t_ns, in.frame.t_ns, bias);
+      ++(R_prev_curr ? frames_predicted : frames_unpredicted);
+    }
+    prev_t_ns = in.frame.t_ns;
+    TrackedFrame out = tracker.process(in.frame, R_prev_curr);
+    features_predicted += out.stats.predicted;
+    features_tracked += out.stats.tracked;
+    features_lost_flow += out.stats.lost_flow;
+    features_lost_back += out.stats.lost_back;
+    return out;
   }
 };
 
@@ -42,6 +71,7 @@ struct EstimatorStage {
   FrameImuPairer pairer;
   estimator::SlidingWindowEstimator estimator;
   LatestValue<NavState>& latest;
+  LatestValue<Eigen::Vector3d>& gyro_bias;  ///< the same state's gyro bias, for the tracker thread
   int64_t tracking = 0, resets = 0;
 
   std::vector<WindowEstimate> process(EstimatorInput in) {
@@ -58,7 +88,9 @@ struct EstimatorStage {
       const WindowEstimate& e = out.back();
       if (e.status == estimator::EstimatorStatus::Tracking) {
         ++tracking;
-        latest.write(estimator.latestState());
+        const NavState s = estimator.latestState();
+        latest.write(s);
+        gyro_bias.write(s.bias_gyr);
       }
       if (e.status == estimator::EstimatorStatus::Reset) ++resets;
       if (!e.event.empty()) spdlog::info("estimator: t = {} ns: {}", e.t_ns, e.event);
@@ -95,16 +127,28 @@ VioRunResult runVio(io::SensorSource& source, const VioRunOptions& opt, const Vi
   VioRunResult result;
   result.source = source.describe();
 
-  TrackerStage tracker{StereoTracker(TrackerOptions::from(opt.estimator), opt.estimator.cameras[0],
-                                     opt.mode.stereo ? opt.estimator.cameras[1] : nullptr),
-                       !opt.mode.stereo};
+  const ImuStageOptions imu_options = ImuStageOptions::from(opt.estimator, opt.imu_rate_hz, opt.imu_noise);
+  std::optional<GyroRotationPredictor> gyro;
+  // With estimate_extrinsic 2 and no body_T_cam0 in the yaml the extrinsic is a placeholder identity:
+  // a rotation conjugated by it would seed KLT in the wrong direction.
+  const bool extrinsic_known = opt.estimator.estimate_extrinsic != 2 || opt.estimator.keys_from_file.count("body_T_cam0");
+  if (opt.gyro_prediction && !extrinsic_known)
+    spdlog::warn("gyro prediction off: the config has no body_T_cam0 (estimate_extrinsic 2)");
+  const bool predict = opt.gyro_prediction && extrinsic_known;
+  // Same outage threshold as the IMU stage's interval builder.
+  if (predict)
+    gyro.emplace(opt.estimator.body_T_cam.at(0), std::llround(imu_options.gap_periods * 1e9 / imu_options.imu_rate_hz));
   LatestValue<NavState> latest;
-  ImuThreadStage imu{ImuStage(ImuStageOptions::from(opt.estimator, opt.imu_rate_hz, opt.imu_noise)), latest};
-  EstimatorStage est{FrameImuPairer{}, estimator::SlidingWindowEstimator(opt.estimator, opt.mode), latest};
+  LatestValue<Eigen::Vector3d> gyro_bias;
+  TrackerStage tracker(StereoTracker(TrackerOptions::from(opt.estimator), opt.estimator.cameras[0],
+                                     opt.mode.stereo ? opt.estimator.cameras[1] : nullptr),
+                       !opt.mode.stereo, std::move(gyro), gyro_bias);
+  ImuThreadStage imu{ImuStage(imu_options), latest};
+  EstimatorStage est{FrameImuPairer{}, estimator::SlidingWindowEstimator(opt.estimator, opt.mode), latest, gyro_bias};
   WriterStage writer{sinks};
 
   Pipeline p;
-  auto& frames = p.add_queue<StereoFrame>("frames", opt.frame_queue, paced ? Backpressure::DropOldest : Backpressure::Block);
+  auto& frames = p.add_queue<TrackerInput>("frames", opt.frame_queue, paced ? Backpressure::DropOldest : Backpressure::Block);
   auto& imu_in = p.add_queue<ImuStageInput>("imu", opt.imu_queue, Backpressure::Block);
   auto& est_in = p.add_fan_in<EstimatorInput>("estimator_in", opt.estimator_queue, Backpressure::Block);
   auto& estimates = p.add_queue<WindowEstimate>("estimates", opt.output_queue, Backpressure::Block);
@@ -126,21 +170,28 @@ VioRunResult runVio(io::SensorSource& source, const VioRunOptions& opt, const Vi
           if (stop.aborted()) return false;
           throw std::runtime_error("IMU queue full: the IMU stage fell behind (IMU is never dropped)");
         };
+        // With prediction, a frame waits here for the first IMU sample at or after it (see FrameImuAttacher).
+        FrameImuAttacher attacher;
+        auto push_frame = [&](std::optional<TrackerInput> f) { return !f || frames.push(std::move(*f)); };
         ReplaySinks s;
         s.frame = [&](StereoFrame&& f) {
           stop_if_asked();
           if (!push_imu(FrameTime{f.t_ns})) return false;
-          return frames.push(std::move(f));
+          if (!predict) return frames.push(TrackerInput{std::move(f), {}});
+          return push_frame(attacher.addFrame(std::move(f)));
         };
         s.imu = [&](ImuSample&& x) {
           stop_if_asked();
-          return push_imu(std::move(x));
+          if (!predict) return push_imu(std::move(x));
+          const ImuSample copy = x;
+          return push_imu(std::move(x)) && push_frame(attacher.addImu(copy));
         };
         s.ground_truth = [&](GroundTruthState&& g) {
           result.ground_truth.push_back(std::move(g));
           return true;
         };
         result.replay = replay(source, {opt.rate, opt.show_progress}, s, stop);
+        push_frame(attacher.finish());
       },
       [&] {
         frames.close();
@@ -158,6 +209,13 @@ VioRunResult runVio(io::SensorSource& source, const VioRunOptions& opt, const Vi
   for (const auto& s : result.report.stages) {
     if (s.name == "tracker") result.frames_tracked = static_cast<int64_t>(s.processed);
   }
+  result.gyro_prediction = predict;
+  result.frames_gyro_predicted = tracker.frames_predicted;
+  result.frames_gyro_unpredicted = tracker.frames_unpredicted;
+  result.features_gyro_predicted = tracker.features_predicted;
+  result.features_tracked = tracker.features_tracked;
+  result.features_lost_flow = tracker.features_lost_flow;
+  result.features_lost_back = tracker.features_lost_back;
   result.frames_estimated = est.pairer.stats().emitted;
   result.frames_tracking = est.tracking;
   result.resets = est.resets;

@@ -1,11 +1,16 @@
 #pragma once
 // The visual-inertial run (DESIGN.md §2) wired on pipeline::Pipeline, one thread per box:
 //
-//   replay ─┬─ stereo frames (SPSC, 8) ──▶ tracker ── tracked frames ──┐
-//           │                                                          ▼ (fan-in)
-//           └─ IMU + frame times (SPSC, 4000) ──▶ imu ── intervals ──▶ estimator ── estimates ──▶ writer
-//                                                   ▲                      │
-//                                                   └─ latest NavState ────┘ (LatestValue: biases)
+//   replay ─┬─ stereo frames + their gyro samples (SPSC, 8) ──▶ tracker ── tracked frames ──┐
+//           │                                                      ▲                        ▼ (fan-in)
+//           └─ IMU + frame times (SPSC, 4000) ──▶ imu ── intervals ┼─────────────────▶ estimator ── estimates ──▶ writer
+//                                                  ▲               └─ gyro bias ───────────┤ (LatestValue)
+//                                                  └─ latest NavState ─────────────────────┘ (LatestValue: biases)
+//
+// Gyro prediction (on by default): the replay packs each frame with the IMU samples of its interval
+// (FrameImuAttacher), the tracker integrates them (GyroRotationPredictor, minus the estimator's newest gyro
+// bias) and seeds its KLT with the rotation. A frame whose interval is not covered (the first, one after a
+// dropped frame, an IMU outage) is tracked without prediction and counted.
 //
 // rate 0: every queue blocks (lossless, repeatable); rate > 0: the frame queue drops the oldest frames
 // when the tracker falls behind (counted). IMU is never dropped: a full IMU queue in real time is an error.
@@ -41,6 +46,9 @@ struct VioRunOptions {
   std::size_t imu_queue = 4000;      ///< IMU samples and frame times waiting for the IMU stage
   std::size_t estimator_queue = 64;  ///< tracked frames and intervals waiting for the estimator
   std::size_t output_queue = 64;     ///< estimates waiting for the writer
+  /// Seed the tracker's KLT with the gyro-integrated rotation (off by default: the gyro bias comes from
+  /// the estimator thread, so a run then depends on thread timing and is no longer bit-repeatable).
+  bool gyro_prediction = false;
 };
 
 /// Where the estimates go; called on the writer thread, one call per processed frame, in time order.
@@ -58,6 +66,16 @@ struct VioRunResult {
   int64_t frames_estimated = 0; ///< frames the estimator processed (= estimates written)
   int64_t frames_tracking = 0;  ///< estimates with status Tracking
   int64_t resets = 0;           ///< estimates with status Reset
+  /// Gyro prediction: frames tracked with and without a predicted rotation (the first frame, one after a
+  /// dropped frame or an IMU outage), and features whose KLT converged from the prediction (all 0 when off;
+  /// TrackerStats::predicted, counted before the min-distance mask, so it may exceed features_tracked).
+  bool gyro_prediction = false;
+  int64_t frames_gyro_predicted = 0;
+  int64_t frames_gyro_unpredicted = 0;
+  int64_t features_gyro_predicted = 0;
+  int64_t features_tracked = 0;    ///< features carried over from the previous frame, summed over frames
+  int64_t features_lost_flow = 0;  ///< tracks lost by KLT (failed or left the image), summed over frames
+  int64_t features_lost_back = 0;  ///< tracks lost by the forward-backward check, summed over frames
   ImuStageStats imu;
   ImuIntervalBuilderStats imu_builder;
   FrameImuPairerStats pairer;

@@ -1,5 +1,6 @@
 // runVio on the real EuRoC clip (95 stereo frames, 4.7 s): completes losslessly at full speed, accounts
-// for every frame when paced, writes well-formed outputs, and stops cleanly on a stop request or SIGINT.
+// for every frame when paced, writes well-formed outputs, seeds the tracker with the gyro (or not, when
+// asked), and stops cleanly on a stop request or SIGINT.
 #include <catch2/catch.hpp>
 
 #include <csignal>
@@ -27,11 +28,12 @@ const std::string kClip = std::string(DYNAVINS_SHARED_DIR) + "/data/euroc_v1_01_
 const std::string kConfig = std::string(DYNAVINS_SHARED_DIR) + "/data/vins_fusion_euroc_config/euroc_stereo_imu_config.yaml";
 constexpr int64_t kClipFrames = 95;
 
-VioRunOptions clipOptions(double rate = 0.0) {
+VioRunOptions clipOptions(double rate = 0.0, bool gyro_prediction = true) {
   VioRunOptions o;
   o.estimator = EstimatorOptions::load(kConfig);
   o.rate = rate;
   o.show_progress = false;
+  o.gyro_prediction = gyro_prediction;
   return o;
 }
 
@@ -68,7 +70,7 @@ struct RunWithOutputs {
 
 // Runs the clip into `dir`; `on_estimate(n)` is called on the writer thread after the n-th estimate.
 RunWithOutputs runClip(const std::string& dir, double rate, const StopFlag* stop = nullptr,
-                       std::function<void(int)> on_estimate = {}) {
+                       std::function<void(int)> on_estimate = {}, bool gyro_prediction = true) {
   RunWithOutputs r;
   r.outputs = std::make_unique<RunOutputs>(dir);
   int n = 0;
@@ -78,7 +80,7 @@ RunWithOutputs runClip(const std::string& dir, double rate, const StopFlag* stop
     if (on_estimate) on_estimate(++n);
   };
   auto source = clip();
-  r.result = runVio(*source, clipOptions(rate), sinks, stop);
+  r.result = runVio(*source, clipOptions(rate, gyro_prediction), sinks, stop);
   RunDescription what{kConfig, "euroc:" + kClip, "dynavins", true, rate};
   if (r.result.report.ok) r.outputs->complete(r.result, what);
   return r;
@@ -89,6 +91,7 @@ void checkFrameAccounting(const VioRunResult& r) {
   CHECK(r.frames_tracked == r.frames_estimated + r.pairer.unpaired_at_finish + r.pairer.skipped_inside_interval +
                                 r.pairer.frames_out_of_order);
   for (const auto& q : r.report.queues) CHECK(q.pushed == q.delivered + q.dropped);
+  if (r.gyro_prediction) CHECK(r.frames_gyro_predicted + r.frames_gyro_unpredicted == r.frames_tracked);
 }
 
 void checkOutputsWellFormed(const std::string& dir, const RunOutputs& out) {
@@ -147,6 +150,30 @@ TEST_CASE("runVio at full speed processes every frame of the EuRoC clip, lossles
   CHECK(json.find("\"frames_in\": 95,") != std::string::npos);
   CHECK(json.find("\"frames_dropped\": 0,") != std::string::npos);
   CHECK(json.find("\"interrupted\": false,") != std::string::npos);
+  // The IMU covers every interval: only the first frame goes without a gyro-predicted rotation.
+  CHECK(res.frames_gyro_predicted == kClipFrames - 1);
+  CHECK(res.frames_gyro_unpredicted == 1);
+  CHECK(res.features_gyro_predicted > 0);
+  CHECK(res.features_gyro_predicted > res.features_tracked / 2);  // most KLT converge from the prediction
+  CHECK(json.find("\"tracker\": {\"gyro_prediction\": true, \"frames_gyro_predicted\": 94, "
+                  "\"frames_gyro_unpredicted\": 1,") != std::string::npos);
+  fs::remove_all(dir);
+}
+
+TEST_CASE("runVio with gyro prediction off tracks every frame unseeded", "[vio]") {
+  const std::string dir = freshDir("nogyro");
+  RunWithOutputs r = runClip(dir, 0.0, nullptr, {}, /*gyro_prediction=*/false);
+  const VioRunResult& res = r.result;
+  INFO(res.report.error);
+  REQUIRE(res.report.ok);
+  CHECK(res.frames_tracked == kClipFrames);
+  CHECK(res.frames_estimated == kClipFrames);
+  CHECK(res.frames_gyro_predicted == 0);
+  CHECK(res.frames_gyro_unpredicted == 0);
+  CHECK(res.features_gyro_predicted == 0);
+  CHECK(res.features_tracked > 0);
+  checkFrameAccounting(res);
+  CHECK(r.outputs->summaryJson().find("\"tracker\": {\"gyro_prediction\": false,") != std::string::npos);
   fs::remove_all(dir);
 }
 
@@ -158,6 +185,8 @@ TEST_CASE("runVio paced in real time accounts for every frame, dropped ones incl
   CHECK(r.result.replay.frames == kClipFrames);
   checkFrameAccounting(r.result);
   CHECK(r.result.frames_estimated >= 1);
+  // A frame after a dropped one has no IMU back to the tracker's previous frame: no prediction.
+  CHECK(r.result.frames_gyro_unpredicted >= 1 + (r.result.frames_dropped > 0 ? 1 : 0));
   checkOutputsWellFormed(dir, *r.outputs);
   fs::remove_all(dir);
 }
