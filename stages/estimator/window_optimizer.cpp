@@ -1,6 +1,7 @@
 #include "stages/estimator/window_optimizer.hpp"
 
 #include <algorithm>
+#include <array>
 #include <chrono>
 #include <cmath>
 #include <unordered_map>
@@ -141,9 +142,10 @@ struct FeatureGeometry {
   }
 };
 
-}  // namespace
-
-double WindowOptimizer::featureResidual(const WindowState& s, const WindowFeature& f) const {
+/// featureResidual() with the camera poses from `camera(slot, cam)` and `g` as reusable scratch.
+template <typename CameraOf>
+double featureResidualWith(const WindowFeature& f, const WindowSolveOptions& opt, const CameraOf& camera,
+                           FeatureGeometry& g) {
   // r_j is measured at the depth that best explains all the feature's observations with the poses
   // fixed, not at the BA's current depth: once a feature's weight is low, the unweighted stereo
   // residual alone sets its BA depth, and a distant point with a slightly wrong disparity would then
@@ -151,16 +153,23 @@ double WindowOptimizer::featureResidual(const WindowState& s, const WindowFeatur
   // only "is this track consistent with a static point under the estimated motion?". The stereo
   // observations of every frame stay in that fit, so an object moving with the camera (which a point at
   // infinity would explain without them) still does not fit.
-  FeatureGeometry g;
-  g.anchor = s.camera(f.start_slot, 0);
+  g.anchor = camera(f.start_slot, 0);
   g.bearing = Eigen::Vector3d(f.obs[0].xy.x(), f.obs[0].xy.y(), 1.0);
-  g.sqrt_info = opt_.sqrt_info;
+  g.sqrt_info = opt.sqrt_info;
+  g.obs.clear();
   for (size_t k = 0; k < f.obs.size(); ++k) {
     const int j = f.start_slot + static_cast<int>(k);
-    if (k > 0) g.obs.push_back({s.camera(j, 0), f.obs[k].xy, true});
-    if (opt_.stereo && f.obs[k].has_right) g.obs.push_back({s.camera(j, 1), f.obs[k].xy_right, k > 0});
+    if (k > 0) g.obs.push_back({camera(j, 0), f.obs[k].xy, true});
+    if (opt.stereo && f.obs[k].has_right) g.obs.push_back({camera(j, 1), f.obs[k].xy_right, k > 0});
   }
   return g.weightedMean(g.bestInverseDepth(f.inv_depth));
+}
+
+}  // namespace
+
+double WindowOptimizer::featureResidual(const WindowState& s, const WindowFeature& f) const {
+  FeatureGeometry g;
+  return featureResidualWith(f, opt_, [&s](int k, int c) { return s.camera(k, c); }, g);
 }
 
 SolveStats WindowOptimizer::solve(WindowState& s, int newest, WindowFeatures& features) {
@@ -171,6 +180,9 @@ SolveStats WindowOptimizer::solve(WindowState& s, int newest, WindowFeatures& fe
   po.cost_function_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
   po.loss_function_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
   po.manifold_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
+  // The blocks and residuals below are well-formed by construction; skip Ceres' per-call validation
+  // (it only checks arguments, the problem and its solution are the same).
+  po.disable_all_safety_checks = true;
   ceres::Problem problem(po);
   PoseManifold pose_manifold;
   std::vector<std::shared_ptr<ceres::CostFunction>> costs;  // alive until the problem goes
@@ -229,11 +241,17 @@ SolveStats WindowOptimizer::solve(WindowState& s, int newest, WindowFeatures& fe
     return summary.termination_type == ceres::CONVERGENCE;
   };
   // Weight step (eq. 10 in closed form); returns the share of weights that moved less than the tolerance.
+  std::vector<std::array<CameraPose, 2>> cameras(newest + 1);
+  FeatureGeometry geometry;
   auto weightStep = [&]() {
     const auto t0 = Clock::now();
+    // The states are fixed during the weight step: each slot's camera poses once, not per observation.
+    for (int k = 0; k <= newest; ++k) cameras[k] = {s.camera(k, 0), s.camera(k, 1)};
+    auto camera = [&cameras](int k, int c) -> const CameraPose& { return cameras[k][c]; };
     int settled = 0;
     for (WindowFeature* f : in_ba) {
-      const double w = solveFeatureWeight(featureResidual(s, *f), f->weight_prev, f->times_solved, opt_.weights);
+      const double r = featureResidualWith(*f, opt_, camera, geometry);
+      const double w = solveFeatureWeight(r, f->weight_prev, f->times_solved, opt_.weights);
       if (std::abs(w - f->weight) < opt_.settle_tolerance) ++settled;
       f->weight = w;
     }

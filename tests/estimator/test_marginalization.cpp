@@ -532,6 +532,73 @@ TEST_CASE("Robust losses enter the prior exactly as Ceres' own Gauss-Newton syst
   CHECK(r.norm() > 0.3);
 }
 
+TEST_CASE("Scalar dropped blocks (inverse depths) are eliminated to the same Schur complement as a dense H",
+          "[estimator][marginalization]") {
+  // Dropped: p (size 3, like a pose) and scalars d0..d5 (like inverse depths); kept: k0 (3), k1 (2).
+  // d0..d3 each sit in factors with p/k0/k1 only (eliminated one by one), d4 and d5 share a factor (so
+  // both go through the dense pseudo-inverse); one variant gives d3 no information at all (H_dd = 0).
+  for (const bool uninformative : {false, true}) {
+    std::mt19937 rng(uninformative ? 31 : 29);
+    std::array<double, 3> p{0.1, 0.2, 0.3}, k0{1, -1, 0.5};
+    std::array<double, 2> k1{0.3, 0.7};
+    std::vector<std::array<double, 1>> d(6);
+    for (size_t i = 0; i < d.size(); ++i) d[i] = {0.2 + 0.1 * static_cast<double>(i)};
+    std::vector<double*> blocks{p.data(), k0.data(), k1.data()};
+    for (auto& di : d) blocks.push_back(di.data());
+    const std::vector<int> sizes{3, 3, 2, 1, 1, 1, 1, 1, 1};
+    auto factor = [&](std::vector<int> idx, int rows, std::shared_ptr<ceres::LossFunction> loss = nullptr) {
+      std::vector<Eigen::MatrixXd> a;
+      for (int i : idx) {
+        a.push_back(randomMatrix(rows, sizes[i], rng));
+        if (uninformative && i == 6) a.back().setZero();
+      }
+      return TestFactor{std::make_shared<LinearFactor>(a, Eigen::VectorXd(randomMatrix(rows, 1, rng))), idx, loss};
+    };
+    std::vector<TestFactor> factors{
+        factor({0}, 3),  // p alone
+        factor({0, 1}, 3),
+        factor({0, 1, 3}, 2),
+        factor({0, 2, 3}, 2, std::make_shared<ceres::HuberLoss>(0.2)),
+        factor({0, 1, 4}, 2),
+        factor({1, 2, 4}, 2),
+        factor({0, 2, 5}, 2),
+        factor({5}, 1),
+        factor({0, 1, 6}, 2),
+        factor({0, 1, 7, 8}, 2),
+        factor({0, 2, 7}, 2),
+        factor({1, 8}, 1),
+    };
+    const std::set<int> dropped{0, 3, 4, 5, 6, 7, 8};
+    const auto info = marginalizeBlocks(factors, blocks, dropped);
+    REQUIRE(info->keptBlocks() == std::vector<double*>{k0.data(), k1.data()});
+
+    // Reference: Ceres' own Jacobian and gradient, Schur complement with a pseudo-inverse of H_mm.
+    ceres::Problem problem(nonOwningOptions());
+    addRemainingFactors(problem, factors, blocks, {});
+    std::vector<double*> order;  // dropped first, then kept
+    for (int i : {0, 3, 4, 5, 6, 7, 8, 1, 2}) order.push_back(blocks[i]);
+    const Eigen::MatrixXd J = denseJacobian(problem, order);
+    std::vector<double> gradient;
+    ceres::Problem::EvaluateOptions eo;
+    eo.parameter_blocks = order;
+    problem.Evaluate(eo, nullptr, nullptr, &gradient, nullptr);
+    const Eigen::MatrixXd H = J.transpose() * J;
+    const Eigen::VectorXd b = Eigen::Map<const Eigen::VectorXd>(gradient.data(), H.rows());
+    const int m = 9, n = 5;
+    const Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> eig(H.topLeftCorner(m, m));
+    const Eigen::VectorXd inv = (eig.eigenvalues().array() > 1e-8).select(eig.eigenvalues().array().inverse(), 0.0);
+    const Eigen::MatrixXd hmm_inv = eig.eigenvectors() * inv.asDiagonal() * eig.eigenvectors().transpose();
+    const Eigen::MatrixXd h_star = H.bottomRightCorner(n, n) - H.bottomLeftCorner(n, m) * hmm_inv * H.topRightCorner(m, n);
+    const Eigen::VectorXd b_star = b.tail(n) - H.bottomLeftCorner(n, m) * hmm_inv * b.head(m);
+
+    const Eigen::MatrixXd& Jm = info->linearizedJacobian();
+    INFO("uninformative d3: " << uninformative);
+    CHECK((Jm.transpose() * Jm - h_star).cwiseAbs().maxCoeff() < 1e-9 * h_star.cwiseAbs().maxCoeff());
+    CHECK((Jm.transpose() * info->linearizedResidual() - b_star).cwiseAbs().maxCoeff() <
+          1e-9 * (1.0 + b_star.cwiseAbs().maxCoeff()));
+  }
+}
+
 TEST_CASE("keptBlocks follows the linearized column order and applies the address shift",
           "[estimator][marginalization]") {
   // Kept blocks of sizes 3, 1, 2 with priors of distinct weights, plus a dropped block d linked to a.

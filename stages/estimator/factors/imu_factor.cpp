@@ -46,6 +46,17 @@ Eigen::Matrix<double, 15, 15> ImuFactor::sqrtInformation(const ImuPreintegration
   return Eigen::LLT<Ip::Matrix15>(information).matrixL().transpose();
 }
 
+Eigen::Matrix<double, 15, 15> ImuFactor::whitening(const ImuPreintegration::Matrix15& covariance) const {
+  // A solve evaluates the factor many times with the same preintegration: invert and factor once.
+  std::lock_guard<std::mutex> lock(cache_mutex_);
+  if (!cache_valid_ || covariance != cached_covariance_) {
+    cached_covariance_ = covariance;
+    cached_sqrt_information_ = sqrtInformation(covariance);
+    cache_valid_ = true;
+  }
+  return cached_sqrt_information_;
+}
+
 bool ImuFactor::Evaluate(double const* const* parameters, double* residuals, double** jacobians) const {
   const Ip& pre = *preintegration_;
   const Eigen::Map<const Vector3> Pi(parameters[0]), Vi(parameters[1]), Bai(parameters[1] + 3),
@@ -53,7 +64,7 @@ bool ImuFactor::Evaluate(double const* const* parameters, double* residuals, dou
   const Quat Qi(Eigen::Map<const Quat>(parameters[0] + 3)), Qj(Eigen::Map<const Quat>(parameters[2] + 3));
 
   const Ip::Vector15 e = pre.evaluateResidual(Pi, Qi, Vi, Bai, Bgi, Pj, Qj, Vj, Baj, Bgj, gravity_);
-  const Ip::Matrix15 S = sqrtInformation(pre.covariance());
+  const Ip::Matrix15 S = whitening(pre.covariance());
   Eigen::Map<Ip::Vector15> r(residuals);
   r = S * e;
   if (jacobians == nullptr) return true;

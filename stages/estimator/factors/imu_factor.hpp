@@ -6,6 +6,8 @@
 // information P^-1, so ||r||² = e^T P^-1 e (Mahalanobis). Pose Jacobians fill the 6 tangent columns
 // [δp, δθ] (right perturbation) and leave column 7 zero.
 
+#include <mutex>
+
 #include <ceres/sized_cost_function.h>
 
 #include "stages/imu/imu_preintegration.hpp"
@@ -25,8 +27,15 @@ class ImuFactor final : public ceres::SizedCostFunction<15, 7, 9, 7, 9> {
   static Eigen::Matrix<double, 15, 15> sqrtInformation(const ImuPreintegration::Matrix15& covariance);
 
  private:
+  /// sqrtInformation(covariance), recomputed only when the preintegration's covariance changed.
+  Eigen::Matrix<double, 15, 15> whitening(const ImuPreintegration::Matrix15& covariance) const;
+
   const ImuPreintegration* preintegration_;
   double gravity_;
+  mutable std::mutex cache_mutex_;
+  mutable bool cache_valid_ = false;
+  mutable ImuPreintegration::Matrix15 cached_covariance_;
+  mutable Eigen::Matrix<double, 15, 15> cached_sqrt_information_;
 };
 
 }  // namespace dynavins::estimator

@@ -1,5 +1,6 @@
 #include "stages/estimator/marginalization/marginalization_info.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <stdexcept>
 #include <string>
@@ -13,20 +14,23 @@ namespace dynavins::estimator {
 namespace {
 
 using RowMajorMatrix = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>;
+using ConstMap = Eigen::Map<const Eigen::MatrixXd>;
+using MutMap = Eigen::Map<Eigen::MatrixXd>;
 
 /// Applies a robust loss to a residual and its Jacobians the way Ceres' internal Corrector does
 /// (ceres/internal/corrector.cc; Triggs et al. 2000, §4.3): with s = |r|^2 and rho = (ρ, ρ', ρ''),
 ///   ρ'' <= 0 (Huber, Cauchy, ...):  r <- sqrt(ρ') r,            J <- sqrt(ρ') J
 ///   ρ'' >  0:  α = 1 - sqrt(1 + 2 s ρ''/ρ'),  r <- sqrt(ρ')/(1-α) r,  J <- sqrt(ρ') (I - α r r^T/s) J
 /// so that (J^T J, J^T r) is the Hessian/gradient the solver itself forms for that residual.
-void applyLoss(const ceres::LossFunction& loss, Eigen::VectorXd& r, std::vector<Eigen::MatrixXd>& jacobians) {
+/// `jacobian` holds every block's tangent Jacobian side by side (rows x total tangent columns).
+void applyLoss(const ceres::LossFunction& loss, Eigen::Map<Eigen::VectorXd> r, MutMap jacobian) {
   const double sq_norm = r.squaredNorm();
   double rho[3];
   loss.Evaluate(sq_norm, rho);
   if (!(rho[1] > 0.0)) {
     // ρ' = 0 (e.g. Tukey beyond its scale): the residual carries no information here.
     r.setZero();
-    for (auto& j : jacobians) j.setZero();
+    jacobian.setZero();
     return;
   }
   const double sqrt_rho1 = std::sqrt(rho[1]);
@@ -38,9 +42,11 @@ void applyLoss(const ceres::LossFunction& loss, Eigen::VectorXd& r, std::vector<
     alpha_sq_norm = alpha / sq_norm;
   }
   // Jacobians first: the correction uses the unscaled residual.
-  for (auto& j : jacobians) {
-    const Eigen::RowVectorXd rt_j = r.transpose() * j;
-    j = sqrt_rho1 * (j - alpha_sq_norm * r * rt_j);
+  if (alpha_sq_norm != 0.0) {
+    const Eigen::RowVectorXd rt_j = r.transpose() * jacobian;
+    jacobian = sqrt_rho1 * (jacobian - alpha_sq_norm * r * rt_j);
+  } else {
+    jacobian *= sqrt_rho1;
   }
   r *= residual_scaling;
 }
@@ -62,107 +68,255 @@ void MarginalizationInfo::add(ResidualBlockInfo residual) {
     throw std::invalid_argument("MarginalizationInfo::add: " + std::to_string(residual.blocks.size()) +
                                 " blocks for a cost with " + std::to_string(sizes.size()));
   }
+  std::vector<int> indices(sizes.size());
   for (size_t i = 0; i < sizes.size(); ++i) {
     double* block = residual.blocks[i];
     if (block == nullptr) throw std::invalid_argument("MarginalizationInfo::add: null parameter block");
-    const auto [it, inserted] = block_size_.emplace(block, sizes[i]);
+    const auto [it, inserted] = block_index_.emplace(block, static_cast<int>(blocks_.size()));
     if (inserted) {
       blocks_.push_back(block);
-    } else if (it->second != sizes[i]) {
+      sizes_.push_back(sizes[i]);
+      is_dropped_.push_back(0);
+    } else if (sizes_[it->second] != sizes[i]) {
       throw std::invalid_argument("MarginalizationInfo::add: block seen with sizes " +
-                                  std::to_string(it->second) + " and " + std::to_string(sizes[i]));
+                                  std::to_string(sizes_[it->second]) + " and " + std::to_string(sizes[i]));
     }
+    indices[i] = it->second;
   }
   for (int d : residual.drop) {
     if (d < 0 || d >= static_cast<int>(residual.blocks.size())) {
       throw std::invalid_argument("MarginalizationInfo::add: drop index " + std::to_string(d) + " out of range");
     }
-    dropped_.insert(residual.blocks[d]);
+    is_dropped_[indices[d]] = 1;
   }
+  residual_blocks_.push_back(std::move(indices));
   residuals_.push_back(std::move(residual));
 }
 
 void MarginalizationInfo::linearize() {
-  linearizations_.clear();
-  linearizations_.reserve(residuals_.size());
-  for (const ResidualBlockInfo& res : residuals_) {
+  // Buffer layout per residual: residual (rows), then the tangent Jacobians side by side (column-major
+  // rows x Σ tangent sizes, i.e. block after block).
+  size_t total = 0;
+  lin_offset_.resize(residuals_.size());
+  for (size_t k = 0; k < residuals_.size(); ++k) {
+    lin_offset_[k] = total;
+    int cols = 0;
+    for (int b : residual_blocks_[k]) cols += tangentSize(sizes_[b]);
+    total += static_cast<size_t>(residuals_[k].cost->num_residuals()) * (1 + cols);
+  }
+  lin_data_.assign(total, 0.0);
+  std::vector<double> ambient;  // row-major ambient Jacobians of one residual, reused
+  std::vector<double*> jacobian_ptrs;
+  for (size_t k = 0; k < residuals_.size(); ++k) {
+    const ResidualBlockInfo& res = residuals_[k];
     const ceres::CostFunction& cost = *res.cost;
-    const std::vector<int32_t>& sizes = cost.parameter_block_sizes();
+    const std::vector<int>& blocks = residual_blocks_[k];
     const int rows = cost.num_residuals();
-    std::vector<RowMajorMatrix> ambient(sizes.size());
-    std::vector<double*> jacobian_ptrs(sizes.size());
-    for (size_t i = 0; i < sizes.size(); ++i) {
-      ambient[i].setZero(rows, sizes[i]);
-      jacobian_ptrs[i] = ambient[i].data();
+    int ambient_cols = 0, tangent_cols = 0;
+    for (int b : blocks) {
+      ambient_cols += sizes_[b];
+      tangent_cols += tangentSize(sizes_[b]);
     }
-    Linearization lin;
-    lin.residual.resize(rows);
-    if (!cost.Evaluate(res.blocks.data(), lin.residual.data(), jacobian_ptrs.data())) {
+    ambient.assign(static_cast<size_t>(rows) * ambient_cols, 0.0);
+    jacobian_ptrs.resize(blocks.size());
+    for (size_t i = 0, o = 0; i < blocks.size(); ++i) {
+      jacobian_ptrs[i] = ambient.data() + o;
+      o += static_cast<size_t>(rows) * sizes_[blocks[i]];
+    }
+    double* residual = lin_data_.data() + lin_offset_[k];
+    if (!cost.Evaluate(res.blocks.data(), residual, jacobian_ptrs.data())) {
       throw std::runtime_error("MarginalizationInfo::linearize: a residual block failed to evaluate");
     }
     // Tangent Jacobian = ambient Jacobian * PlusJacobian; PoseManifold's is [I6; 0], so a pose block's
     // tangent Jacobian is its first 6 columns (parameter_layout.hpp).
-    lin.jacobians.reserve(sizes.size());
-    for (size_t i = 0; i < sizes.size(); ++i) lin.jacobians.emplace_back(ambient[i].leftCols(tangentSize(sizes[i])));
-    if (res.loss) applyLoss(*res.loss, lin.residual, lin.jacobians);
-    linearizations_.push_back(std::move(lin));
+    double* tangent = residual + rows;
+    for (size_t i = 0; i < blocks.size(); ++i) {
+      const int size = sizes_[blocks[i]];
+      const int t = tangentSize(size);
+      MutMap(tangent, rows, t) = Eigen::Map<const RowMajorMatrix>(jacobian_ptrs[i], rows, size).leftCols(t);
+      tangent += static_cast<size_t>(rows) * t;
+    }
+    if (res.loss) {
+      applyLoss(*res.loss, Eigen::Map<Eigen::VectorXd>(residual, rows), MutMap(residual + rows, rows, tangent_cols));
+    }
   }
   x0_.clear();
-  for (double* block : blocks_) {
-    x0_.emplace(block, Eigen::Map<const Eigen::VectorXd>(block, block_size_.at(block)));
-  }
+  x0_.reserve(blocks_.size());
+  for (size_t i = 0; i < blocks_.size(); ++i) x0_.emplace_back(Eigen::Map<const Eigen::VectorXd>(blocks_[i], sizes_[i]));
   linearized_ = true;
+}
+
+bool MarginalizationInfo::assemble(const std::vector<char>& scalar, Eigen::MatrixXd& H, Eigen::VectorXd& b,
+                                   int& dropped_dense_size) const {
+  const int num_blocks = static_cast<int>(blocks_.size());
+  // Dense column layout: non-scalar dropped blocks first (in order of appearance), then the kept ones.
+  std::vector<int> offset(num_blocks, -1);
+  int total = 0;
+  for (int i = 0; i < num_blocks; ++i) {
+    if (is_dropped_[i] && !scalar[i]) {
+      offset[i] = total;
+      total += tangentSize(sizes_[i]);
+    }
+  }
+  dropped_dense_size = total;
+  for (int i = 0; i < num_blocks; ++i) {
+    if (!is_dropped_[i]) {
+      offset[i] = total;
+      total += tangentSize(sizes_[i]);
+    }
+  }
+
+  // A scalar dropped block d couples (through its residuals) with a few dense blocks only, and with no
+  // other scalar block, so its row of H is h_dd, the coupling c_d = H_{dense,d} over those blocks, b_d.
+  struct Scalar {
+    double h = 0.0, b = 0.0;
+    std::vector<int> neighbours;  ///< dense block indices
+    std::vector<int> local;       ///< offset of each neighbour in c
+    Eigen::VectorXd c;
+  };
+  std::vector<int> scalar_id(num_blocks, -1);
+  std::vector<Scalar> scalars;
+  for (int i = 0; i < num_blocks; ++i) {
+    if (scalar[i]) {
+      scalar_id[i] = static_cast<int>(scalars.size());
+      scalars.emplace_back();
+    }
+  }
+  std::vector<int> residual_scalar(residuals_.size(), -1);  // index into the residual's blocks, or -1
+  for (size_t k = 0; k < residuals_.size(); ++k) {
+    const std::vector<int>& blocks = residual_blocks_[k];
+    for (size_t i = 0; i < blocks.size(); ++i) {
+      if (scalar_id[blocks[i]] >= 0) residual_scalar[k] = static_cast<int>(i);
+    }
+    if (residual_scalar[k] < 0) continue;
+    Scalar& s = scalars[scalar_id[blocks[residual_scalar[k]]]];
+    for (int blk : blocks) {
+      if (scalar_id[blk] >= 0) continue;
+      if (std::find(s.neighbours.begin(), s.neighbours.end(), blk) == s.neighbours.end()) s.neighbours.push_back(blk);
+    }
+  }
+  for (Scalar& s : scalars) {
+    int n = 0;
+    s.local.resize(s.neighbours.size());
+    for (size_t j = 0; j < s.neighbours.size(); ++j) {
+      s.local[j] = n;
+      n += tangentSize(sizes_[s.neighbours[j]]);
+    }
+    s.c = Eigen::VectorXd::Zero(n);
+  }
+
+  // Gauss-Newton system H = Σ J^T J, b = Σ J^T r over all residual blocks; the dense part in its upper
+  // triangle (blocks above the diagonal, diagonal blocks whole), mirrored below afterwards.
+  H.setZero(total, total);
+  b.setZero(total);
+  std::vector<int> col;  // per block of the residual: column in its Jacobian buffer
+  for (size_t k = 0; k < residuals_.size(); ++k) {
+    const std::vector<int>& blocks = residual_blocks_[k];
+    const int rows = residuals_[k].cost->num_residuals();
+    const double* data = lin_data_.data() + lin_offset_[k];
+    const Eigen::Map<const Eigen::VectorXd> r(data, rows);
+    const double* jac = data + rows;
+    col.resize(blocks.size());
+    for (size_t i = 0, c = 0; i < blocks.size(); ++i) {
+      col[i] = static_cast<int>(c);
+      c += tangentSize(sizes_[blocks[i]]);
+    }
+    auto J = [&](size_t i) {
+      return ConstMap(jac + static_cast<size_t>(rows) * col[i], rows, tangentSize(sizes_[blocks[i]]));
+    };
+    const int si = residual_scalar[k];
+    for (size_t i = 0; i < blocks.size(); ++i) {
+      if (static_cast<int>(i) == si) continue;
+      const auto ji = J(i);
+      const int oi = offset[blocks[i]];
+      b.segment(oi, ji.cols()).noalias() += ji.transpose() * r;
+      for (size_t j = 0; j < blocks.size(); ++j) {
+        if (static_cast<int>(j) == si) continue;
+        const int oj = offset[blocks[j]];
+        if (oj < oi) continue;
+        const auto jj = J(j);
+        H.block(oi, oj, ji.cols(), jj.cols()).noalias() += ji.transpose() * jj;
+      }
+    }
+    if (si >= 0) {
+      Scalar& s = scalars[scalar_id[blocks[si]]];
+      const auto jd = J(si);  // rows x 1
+      s.h += jd.squaredNorm();
+      s.b += jd.col(0).dot(r);
+      for (size_t j = 0; j < blocks.size(); ++j) {
+        if (static_cast<int>(j) == si) continue;
+        const auto jj = J(j);
+        const size_t n = std::find(s.neighbours.begin(), s.neighbours.end(), blocks[j]) - s.neighbours.begin();
+        s.c.segment(s.local[n], jj.cols()).noalias() += jj.transpose() * jd.col(0);
+      }
+    }
+  }
+
+  // Eliminate the scalar blocks: H -= c c^T / h_dd, b -= c b_d / h_dd (H_dd is diagonal over them).
+  for (const Scalar& s : scalars) {
+    if (!(s.h > eigenvalue_threshold_)) return false;
+    const double inv_h = 1.0 / s.h;
+    const Eigen::VectorXd c_scaled = s.c * inv_h;
+    for (size_t i = 0; i < s.neighbours.size(); ++i) {
+      const int oi = offset[s.neighbours[i]];
+      const int ti = tangentSize(sizes_[s.neighbours[i]]);
+      const auto ci = s.c.segment(s.local[i], ti);
+      b.segment(oi, ti) -= ci * (s.b * inv_h);
+      for (size_t j = 0; j < s.neighbours.size(); ++j) {
+        const int oj = offset[s.neighbours[j]];
+        if (oj < oi) continue;
+        const int tj = tangentSize(sizes_[s.neighbours[j]]);
+        H.block(oi, oj, ti, tj).noalias() -= ci * c_scaled.segment(s.local[j], tj).transpose();
+      }
+    }
+  }
+  for (int j = 0; j < total; ++j) {
+    for (int i = j + 1; i < total; ++i) H(i, j) = H(j, i);
+  }
+  return true;
 }
 
 void MarginalizationInfo::marginalize() {
   if (!linearized_) throw std::logic_error("MarginalizationInfo::marginalize before linearize()");
 
-  // Column layout: dropped blocks first (in order of appearance), then the kept ones.
-  std::unordered_map<const double*, int> offset;
-  int dropped_size = 0;
-  for (double* block : blocks_) {
-    if (!dropped_.count(block)) continue;
-    offset[block] = dropped_size;
-    dropped_size += tangentSize(block_size_.at(block));
-  }
   kept_blocks_.clear();
   kept_sizes_.clear();
   kept_tangent_offsets_.clear();
   kept_x0_.clear();
-  int total = dropped_size;
-  for (double* block : blocks_) {
-    if (dropped_.count(block)) continue;
-    const int size = block_size_.at(block);
-    offset[block] = total;
-    kept_blocks_.push_back(block);
-    kept_sizes_.push_back(size);
-    kept_tangent_offsets_.push_back(total - dropped_size);
-    kept_x0_.push_back(x0_.at(block));
-    total += tangentSize(size);
+  kept_tangent_size_ = 0;
+  for (size_t i = 0; i < blocks_.size(); ++i) {
+    if (is_dropped_[i]) continue;
+    kept_blocks_.push_back(blocks_[i]);
+    kept_sizes_.push_back(sizes_[i]);
+    kept_tangent_offsets_.push_back(kept_tangent_size_);
+    kept_x0_.push_back(x0_[i]);
+    kept_tangent_size_ += tangentSize(sizes_[i]);
   }
-  kept_tangent_size_ = total - dropped_size;
   if (kept_blocks_.empty()) throw std::runtime_error("MarginalizationInfo::marginalize: no block is kept");
 
-  // Gauss-Newton system H = Σ J^T J, b = Σ J^T r over all residual blocks.
-  Eigen::MatrixXd H = Eigen::MatrixXd::Zero(total, total);
-  Eigen::VectorXd b = Eigen::VectorXd::Zero(total);
-  for (size_t k = 0; k < residuals_.size(); ++k) {
-    const Linearization& lin = linearizations_[k];
-    const std::vector<double*>& blocks = residuals_[k].blocks;
-    for (size_t i = 0; i < blocks.size(); ++i) {
-      const Eigen::MatrixXd& ji = lin.jacobians[i];
-      const int oi = offset.at(blocks[i]);
-      b.segment(oi, ji.cols()) += ji.transpose() * lin.residual;
-      for (size_t j = 0; j < blocks.size(); ++j) {
-        const Eigen::MatrixXd& jj = lin.jacobians[j];
-        H.block(oi, offset.at(blocks[j]), ji.cols(), jj.cols()) += ji.transpose() * jj;
-      }
+  // Dropped blocks of tangent size 1 that share no residual with another such block (the inverse depths
+  // of the features anchored in the dropped frame) have a diagonal H_dd: they are eliminated one by one
+  // while H is formed, which is the same Schur complement (H_dd is positive definite; H is positive
+  // semi-definite, so the rest of H_mm's pseudo-inverse is unaffected) without the dense m x m work.
+  std::vector<char> scalar(blocks_.size(), 0);
+  for (size_t i = 0; i < blocks_.size(); ++i) scalar[i] = is_dropped_[i] && tangentSize(sizes_[i]) == 1;
+  for (const std::vector<int>& blocks : residual_blocks_) {
+    int count = 0;
+    for (int blk : blocks) count += scalar[blk] ? 1 : 0;
+    if (count > 1) {
+      for (int blk : blocks) scalar[blk] = 0;
     }
+  }
+  Eigen::MatrixXd H;
+  Eigen::VectorXd b;
+  int m = 0;
+  if (!assemble(scalar, H, b, m)) {
+    std::fill(scalar.begin(), scalar.end(), 0);
+    assemble(scalar, H, b, m);  // a scalar block without information: pseudo-invert it with the rest
   }
 
   // Schur complement onto the kept blocks; H_mm is inverted through its eigen-decomposition so a
   // rank-deficient dropped block (e.g. an unobservable direction) is pseudo-inverted, not blown up.
-  const int m = dropped_size;
   const int n = kept_tangent_size_;
   Eigen::MatrixXd schur = H.bottomRightCorner(n, n);
   Eigen::VectorXd schur_b = b.tail(n);
@@ -172,9 +326,10 @@ void MarginalizationInfo::marginalize() {
     const Eigen::VectorXd inv = (eig.eigenvalues().array() > eigenvalue_threshold_)
                                     .select(eig.eigenvalues().array().inverse(), 0.0);
     const Eigen::MatrixXd hmm_inv = eig.eigenvectors() * inv.asDiagonal() * eig.eigenvectors().transpose();
-    const Eigen::MatrixXd hkm_hmm_inv = H.bottomLeftCorner(n, m) * hmm_inv;
-    schur -= hkm_hmm_inv * H.topRightCorner(m, n);
-    schur_b -= hkm_hmm_inv * b.head(m);
+    Eigen::MatrixXd hkm_hmm_inv(n, m);
+    hkm_hmm_inv.noalias() = H.bottomLeftCorner(n, m) * hmm_inv;
+    schur.noalias() -= hkm_hmm_inv * H.topRightCorner(m, n);
+    schur_b.noalias() -= hkm_hmm_inv * b.head(m);
   }
   schur = 0.5 * (schur + schur.transpose()).eval();
 
@@ -198,7 +353,10 @@ void MarginalizationInfo::marginalize() {
     linearized_residual_(row) = v.dot(schur_b) / sqrt_s;
   }
   // The residual blocks (and whatever their costs hold, e.g. preintegrations) are no longer needed.
-  linearizations_.clear();
+  lin_data_.clear();
+  lin_data_.shrink_to_fit();
+  lin_offset_.clear();
+  residual_blocks_.clear();
   residuals_.clear();
 }
 

@@ -14,7 +14,6 @@
 
 #include <memory>
 #include <unordered_map>
-#include <unordered_set>
 #include <vector>
 
 #include <Eigen/Core>
@@ -80,19 +79,24 @@ class MarginalizationInfo {
   static int tangentSize(int ambient_size);
 
  private:
-  /// A residual block's whitened residual and tangent Jacobians at x0.
-  struct Linearization {
-    Eigen::VectorXd residual;
-    std::vector<Eigen::MatrixXd> jacobians;  ///< one per block, residual rows x tangent columns
-  };
+  /// Forms the Gauss-Newton system over the "dense" columns (non-scalar dropped blocks first, then the
+  /// kept ones) with the scalar dropped blocks (see marginalize()) already eliminated. Returns false if
+  /// a scalar block has no information (H_dd <= threshold): the caller then retries with none scalar.
+  bool assemble(const std::vector<char>& scalar, Eigen::MatrixXd& H, Eigen::VectorXd& b,
+                int& dropped_dense_size) const;
 
   double eigenvalue_threshold_;
   std::vector<ResidualBlockInfo> residuals_;
   std::vector<double*> blocks_;  ///< every block seen, in order of first appearance
-  std::unordered_map<const double*, int> block_size_;
-  std::unordered_set<const double*> dropped_;
-  std::vector<Linearization> linearizations_;
-  std::unordered_map<const double*, Eigen::VectorXd> x0_;
+  std::vector<int> sizes_;       ///< ambient size of blocks_[i]
+  std::vector<char> is_dropped_;  ///< per blocks_[i]
+  std::unordered_map<const double*, int> block_index_;  ///< address -> index into blocks_
+  std::vector<std::vector<int>> residual_blocks_;       ///< per residual: indices into blocks_
+  /// Linearisation of every residual, whitened and loss-corrected, in one buffer: per residual its
+  /// residual vector then each block's tangent Jacobian (column-major, rows x tangent size).
+  std::vector<double> lin_data_;
+  std::vector<size_t> lin_offset_;  ///< per residual: start of its data in lin_data_
+  std::vector<Eigen::VectorXd> x0_;  ///< per blocks_[i]
   bool linearized_ = false;
 
   std::vector<double*> kept_blocks_;
