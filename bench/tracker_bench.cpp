@@ -4,9 +4,12 @@
 #include <chrono>
 #include <ctime>
 #include <cstdio>
+#include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <numeric>
+#include <sstream>
+#include <string>
 #include <vector>
 
 #include <opencv2/core/utility.hpp>
@@ -79,25 +82,76 @@ std::vector<Variant> variants() {
   return {{"", base}, {"+fransac", ransac}, {"+clahe", clahe}, {"-patch", plain}};
 }
 
-void run_variants(const char* data, const std::vector<StereoFrame>& frames, const CameraModelPtr& c0,
-                  const CameraModelPtr& c1) {
-  for (const Variant& v : variants()) {
-    StereoTracker tracker(v.options, c0, c1);
-    Times ms;
-    std::vector<TrackedFrame> out;
-    for (const auto& f : frames) time_ms(&ms, [&] { out.push_back(tracker.process(f)); });
-    const std::string name = std::string(data) + v.name;
-    report(name.c_str(), ms, out);
-    long rejected = 0;
-    for (const auto& f : out) rejected += f.stats.lost_ransac;
-    if (v.options.f_ransac) std::printf("         F-RANSAC rejected %.2f tracks per frame\n", double(rejected) / out.size());
-  }
+struct Args {
+  bool sim = true, euroc = true;
+  std::vector<std::string> variants;  ///< names as printed after the data set ("base" for none); empty: all
+  int repeat = 1;
+};
+
+bool selected(const Args& a, const Variant& v) {
+  const std::string name = *v.name ? v.name : "base";
+  return a.variants.empty() || std::find(a.variants.begin(), a.variants.end(), name) != a.variants.end();
 }
 
-int main() {
+void run_variants(const Args& args, const char* data, const std::vector<StereoFrame>& frames, const CameraModelPtr& c0,
+                  const CameraModelPtr& c1) {
+  // Repeats run the variants in turn, so a load change on the shared machine hits them all alike.
+  for (int r = 0; r < args.repeat; ++r)
+    for (const Variant& v : variants()) {
+      if (!selected(args, v)) continue;
+      StereoTracker tracker(v.options, c0, c1);
+      Times ms;
+      std::vector<TrackedFrame> out;
+      for (const auto& f : frames) time_ms(&ms, [&] { out.push_back(tracker.process(f)); });
+      const std::string name = std::string(data) + v.name;
+      report(name.c_str(), ms, out);
+      long rejected = 0;
+      for (const auto& f : out) rejected += f.stats.lost_ransac;
+      if (v.options.f_ransac)
+        std::printf("         F-RANSAC rejected %.2f tracks per frame\n", double(rejected) / out.size());
+    }
+}
+
+const char* kUsage =
+    "usage: bench_tracker [--data sim|euroc|all] [--variants base,+fransac,+clahe,-patch] [--repeat N]\n"
+    "  --data      which frames to track (default all)\n"
+    "  --variants  comma-separated tracker variants to time (default all; base = VINS-Fusion settings)\n"
+    "  --repeat    runs of each variant, interleaved (default 1)\n";
+
+[[noreturn]] void usage(int code) {
+  std::fputs(kUsage, code == 0 ? stdout : stderr);
+  std::exit(code);
+}
+
+Args parse(int argc, char** argv) {
+  Args a;
+  for (int i = 1; i < argc; ++i) {
+    const std::string k = argv[i];
+    if (k == "--help" || k == "-h") usage(0);
+    if (i + 1 >= argc) usage(2);
+    const std::string value = argv[++i];
+    if (k == "--data") {
+      a.sim = value == "sim" || value == "all";
+      a.euroc = value == "euroc" || value == "all";
+      if (!a.sim && !a.euroc) usage(2);
+    } else if (k == "--variants") {
+      std::stringstream ss(value);
+      for (std::string v; std::getline(ss, v, ',');) a.variants.push_back(v);
+    } else if (k == "--repeat") {
+      a.repeat = std::atoi(value.c_str());
+      if (a.repeat < 1) usage(2);
+    } else {
+      usage(2);
+    }
+  }
+  return a;
+}
+
+int main(int argc, char** argv) {
+  const Args args = parse(argc, argv);
   cv::setNumThreads(1);  // the goal is per core; the pipeline runs other stages on the other cores
 
-  {  // Generated scene: frames rendered first so only the tracker is timed.
+  if (args.sim) {  // Generated scene: frames rendered first so only the tracker is timed.
     const fs::path path = fs::temp_directory_path() / "dynavins_bench_tracker.yaml";
     std::ofstream(path) << "%YAML:1.0\n---\nname: bench\nseed: 3\nduration: 5\n"
                            "world: { x_min: -10, x_max: 40 }\n"
@@ -113,16 +167,16 @@ int main() {
     SensorEvent e;
     while (src.next(e))
       if (auto* f = std::get_if<StereoFrame>(&e)) frames.push_back(*f);
-    run_variants("sim", frames, cam, cam);
+    run_variants(args, "sim", frames, cam, cam);
   }
-  {
+  if (args.euroc) {
     const std::string dir = std::string(DYNAVINS_SHARED_DIR) + "/data/euroc_v1_01_micro";
     const io::EurocDataset data(dir);
     const auto c0 = load_kalibr_camera(dir + "/mav0/cam0/sensor.yaml");
     const auto c1 = load_kalibr_camera(dir + "/mav0/cam1/sensor.yaml");
     std::vector<StereoFrame> frames;
     for (std::size_t i = 0; i < data.frames().size(); ++i) frames.push_back(data.load(i));
-    run_variants("euroc", frames, c0.camera, c1.camera);
+    run_variants(args, "euroc", frames, c0.camera, c1.camera);
   }
   return 0;
 }

@@ -109,6 +109,7 @@ EstimatorOptions EstimatorOptions::load(const std::string& path) {
   if (o.alternating_converge <= 0 || o.alternating_converge > 1)
     r.fail("alternating_converge", "must be in (0, 1] (fraction of converged weights)");
   l.opt("margin_feature_thresh", o.margin_feature_thresh);
+  l.opt("weighted_huber", o.weighted_huber);
   if (o.margin_feature_thresh < 0 || o.margin_feature_thresh > 1) r.fail("margin_feature_thresh", "must be in [0, 1]");
   return o;
 }
@@ -165,6 +166,7 @@ std::string EstimatorOptions::print() const {
   line("momentum_lambda", lambda_m, " = lambda_m");
   line("alternating_converge", alternating_converge);
   line("margin_feature_thresh", margin_feature_thresh);
+  line("weighted_huber", weighted_huber);
   return s.str();
 }
 
@@ -284,6 +286,7 @@ void EstimatorOptions::apply(const std::string& key, const std::string& value) {
                                        "must be in (0, 1] (fraction of converged weights)")},
       {"margin_feature_thresh",
        real_in(&EstimatorOptions::margin_feature_thresh, 0, 1, false, "must be in [0, 1]")},
+      {"weighted_huber", flag(&EstimatorOptions::weighted_huber)},
   };
   if (fixed.count(key)) bad(key, "describes the sensor rig and cannot be overridden; edit the yaml");
   const auto it = setters.find(key);

@@ -65,6 +65,10 @@ struct EstimatorOptions {
   double lambda_m = 0.2;  ///< key momentum_lambda
   double alternating_converge = 0.9;
   double margin_feature_thresh = 0.1;
+  /// Ours, not the paper's: keep VINS-Fusion's per-observation Huber loss under the per-feature weights
+  /// (dynavins mode). A weight judges a whole track; the Huber loss still bounds one bad observation of a
+  /// kept track (a one-frame KLT slip). 0 gives the paper's eq. 4 exactly (weights replace the Huber loss).
+  bool weighted_huber = true;
 
   std::set<std::string> keys_from_file;      ///< which options the file set (the rest are defaults)
   std::set<std::string> keys_from_override;  ///< which options a command line `--set key=value` set

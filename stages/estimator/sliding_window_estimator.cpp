@@ -33,6 +33,7 @@ WindowSolveOptions solveOptions(const EstimatorOptions& o, const EstimatorMode& 
   s.weights.max_momentum_count = o.window_size;
   s.alternating_converge = o.alternating_converge;
   s.margin_feature_thresh = o.margin_feature_thresh;
+  s.weighted_huber = o.weighted_huber;
   return s;
 }
 

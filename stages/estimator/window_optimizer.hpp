@@ -33,6 +33,7 @@ struct WindowSolveOptions {
   double settle_tolerance = 0.05;
   int max_alternations = 4;
   double margin_feature_thresh = 0.1;  ///< features under this weight stay out of the prior (dynavins)
+  bool weighted_huber = true;  ///< dynavins: Huber loss on each weighted observation too (not the paper's)
 };
 
 class WindowOptimizer {

@@ -15,6 +15,7 @@
 #include "messages/sensor_messages.hpp"
 #include "messages/tracked_frame.hpp"
 #include "stages/common/camera_model.hpp"
+#include "stages/tracker/corner_detector.hpp"
 #include "stages/tracker/patch_template.hpp"
 #include "stages/tracker/tracker_options.hpp"
 
@@ -24,6 +25,11 @@ class StereoTracker {
  public:
   /// `cam1` may be null for mono use; then a frame with a right image throws std::invalid_argument.
   StereoTracker(const TrackerOptions& options, CameraModelPtr cam0, CameraModelPtr cam1 = nullptr);
+  // Movable, not copyable: a copy would share the image buffers both reuse in place.
+  StereoTracker(const StereoTracker&) = delete;
+  StereoTracker& operator=(const StereoTracker&) = delete;
+  StereoTracker(StereoTracker&&) = default;
+  StereoTracker& operator=(StereoTracker&&) = default;
 
   /// Tracks `frame` (8-bit gray left, optional right). `R_prev_curr_cam0`, the rotation of the
   /// current cam0 frame expressed in the previous one (from the gyro), seeds each KLT with the
@@ -52,13 +58,13 @@ class StereoTracker {
   };
 
   cv::Mat prepare(const cv::Mat& img) const;
-  Pyramid pyramid(const cv::Mat& img) const;
+  void pyramid(const cv::Mat& img, Pyramid* pyr) const;
   std::vector<Track> track_temporal(const Pyramid& curr, const std::optional<Eigen::Matrix3d>& R_prev_curr,
                                     std::vector<cv::Point2f>* prev_px, TrackerStats* stats) const;
   void refine_with_patches(const cv::Mat& img, std::vector<Track>* tracks, std::vector<cv::Point2f>* prev_px,
                            TrackerStats* stats) const;
   void reject_with_f(std::vector<Track>* tracks, std::vector<cv::Point2f>* prev_px, TrackerStats* stats) const;
-  void match_stereo(const Pyramid& left, const cv::Mat& right, std::vector<Track>* tracks, TrackedFrame* out) const;
+  void match_stereo(const Pyramid& left, const cv::Mat& right, std::vector<Track>* tracks, TrackedFrame* out);
   void enforce_spacing_and_detect(const cv::Mat& img, std::vector<Track>* tracks, std::vector<cv::Point2f>* prev_px,
                                   TrackerStats* stats);
   bool in_border(const cv::Point2f& p, const cv::Size& size) const;
@@ -67,6 +73,10 @@ class StereoTracker {
   CameraModelPtr cam0_, cam1_;
   cv::Ptr<cv::CLAHE> clahe_;
   Pyramid prev_pyr_;
+  // Buffers reused from frame to frame (image-sized: allocating them afresh costs page faults).
+  Pyramid curr_pyr_, right_pyr_;  ///< curr_pyr_ swaps with prev_pyr_ at the end of a frame
+  cv::Mat right_scaled_, mask_;
+  CornerScratch corner_scratch_;
   std::vector<Track> tracks_;
   int64_t prev_t_ns_ = 0;
   int64_t next_id_ = 0;

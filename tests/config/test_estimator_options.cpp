@@ -162,7 +162,7 @@ TEST_CASE("print() lists every effective option with its source", "[options]") {
                           "max_solver_time", "max_num_iterations", "keyframe_parallax", "acc_n", "gyr_n", "acc_w",
                           "gyr_w", "g_norm", "estimate_td", "td", "estimate_extrinsic", "regularization_lambda",
                           "lambda_w", "momentum_lambda", "alternating_converge", "margin_feature_thresh",
-                          "window_size"})
+                          "weighted_huber", "window_size"})
     CHECK_THAT(p, Catch::Contains(std::string("  ") + key + " "));
   CHECK_THAT(p, Catch::Contains("PINHOLE 752x480 fx=376"));
   CHECK(std::regex_search(p, std::regex("max_cnt +=  ?150 +\\(file\\)")));
