@@ -129,8 +129,8 @@ VioRunResult runVio(io::SensorSource& source, const VioRunOptions& opt, const Vi
 
   const ImuStageOptions imu_options = ImuStageOptions::from(opt.estimator, opt.imu_rate_hz, opt.imu_noise);
   std::optional<GyroRotationPredictor> gyro;
-  // With estimate_extrinsic 2 and no body_T_cam0 in the yaml the extrinsic is a placeholder identity:
-  // a rotation conjugated by it would seed KLT in the wrong direction.
+  // estimate_extrinsic 2 lets a config leave body_T_cam0 out; the loader then stores identity, which is
+  // no calibration: a gyro rotation conjugated by it would seed the KLT in the wrong direction.
   const bool extrinsic_known = opt.estimator.estimate_extrinsic != 2 || opt.estimator.keys_from_file.count("body_T_cam0");
   if (opt.gyro_prediction && !extrinsic_known)
     spdlog::warn("gyro prediction off: the config has no body_T_cam0 (estimate_extrinsic 2)");

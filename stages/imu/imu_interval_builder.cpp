@@ -6,22 +6,9 @@
 
 #include <spdlog/spdlog.h>
 
+#include "stages/imu/imu_sample_interpolation.hpp"
+
 namespace dynavins {
-namespace {
-
-// Linear interpolation of the measurements at t (a.t_ns <= t <= b.t_ns).
-ImuSample interpolate(const ImuSample& a, const ImuSample& b, int64_t t) {
-  if (t == a.t_ns) return a;
-  if (t == b.t_ns) return b;
-  const double w = static_cast<double>(t - a.t_ns) / static_cast<double>(b.t_ns - a.t_ns);
-  ImuSample s;
-  s.t_ns = t;
-  s.acc = (1.0 - w) * a.acc + w * b.acc;
-  s.gyr = (1.0 - w) * a.gyr + w * b.gyr;
-  return s;
-}
-
-}  // namespace
 
 ImuIntervalBuilder::ImuIntervalBuilder(ImuIntervalBuilderOptions options) : opt_(std::move(options)) {
   if (!(opt_.imu_rate_hz > 0.0) || !(opt_.gap_periods >= 1.0))

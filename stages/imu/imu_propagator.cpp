@@ -2,6 +2,8 @@
 
 #include <cmath>
 
+#include "stages/imu/imu_sample_interpolation.hpp"
+
 namespace dynavins {
 
 ImuPropagator::ImuPropagator(ImuPropagatorOptions options) : opt_(options) {}
@@ -14,10 +16,7 @@ void ImuPropagator::reset(const NavState& state) {
   for (size_t k = 0; k + 1 < history_.size(); ++k) {
     const ImuSample &a = history_[k], &b = history_[k + 1];
     if (a.t_ns <= state.t_ns && state.t_ns <= b.t_ns) {
-      const double w = static_cast<double>(state.t_ns - a.t_ns) / static_cast<double>(b.t_ns - a.t_ns);
-      last_.t_ns = state.t_ns;
-      last_.acc = (1.0 - w) * a.acc + w * b.acc;
-      last_.gyr = (1.0 - w) * a.gyr + w * b.gyr;
+      last_ = interpolate(a, b, state.t_ns);
       have_last_ = true;
       break;
     }

@@ -4,17 +4,9 @@
 #include <stdexcept>
 
 #include "stages/common/so3.hpp"
+#include "stages/imu/imu_sample_interpolation.hpp"
 
 namespace dynavins {
-namespace {
-
-// Angular rate linearly interpolated at t (a.t_ns <= t <= b.t_ns, a.t_ns < b.t_ns).
-Eigen::Vector3d gyroAt(const ImuSample& a, const ImuSample& b, int64_t t) {
-  const double w = static_cast<double>(t - a.t_ns) / static_cast<double>(b.t_ns - a.t_ns);
-  return (1.0 - w) * a.gyr + w * b.gyr;
-}
-
-}  // namespace
 
 GyroRotationPredictor::GyroRotationPredictor(const Eigen::Isometry3d& body_T_cam0, int64_t max_gap_ns)
     : R_bc_(body_T_cam0.linear()), max_gap_ns_(max_gap_ns) {
@@ -39,7 +31,7 @@ std::optional<Eigen::Matrix3d> GyroRotationPredictor::predictBody(const std::vec
     if (s.t_ns - prev->t_ns > max_gap_ns_) return std::nullopt;  // an outage: do not bridge it
     // Midpoint rule on the part of the segment inside [t0, t1], rates interpolated at its ends.
     const int64_t a = std::max(prev->t_ns, t0), b = std::min(s.t_ns, t1);
-    const Eigen::Vector3d w = 0.5 * (gyroAt(*prev, s, a) + gyroAt(*prev, s, b)) - bias;
+    const Eigen::Vector3d w = 0.5 * (interpolate(*prev, s, a).gyr + interpolate(*prev, s, b).gyr) - bias;
     R = R * so3::exp(w * (static_cast<double>(b - a) * 1e-9));
     if (s.t_ns >= t1) return R;  // covered to the end
     prev = &s;

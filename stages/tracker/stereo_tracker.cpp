@@ -149,7 +149,6 @@ std::vector<StereoTracker::Track> StereoTracker::track_temporal(const Pyramid& c
   }
   compact(&tracks, status);
   compact(prev_px, status);
-  for (auto& t : tracks) t.bearing = cam0_->lift(to_eigen(t.px));
   return tracks;
 }
 
@@ -175,7 +174,6 @@ void StereoTracker::refine_with_patches(const cv::Mat& img, std::vector<Track>* 
       continue;
     }
     t.px = refined;
-    t.bearing = cam0_->lift(to_eigen(t.px));
     t.warp = w;
     const double s = w.scale();
     if (s > opt_.patch_recapture_scale || s < 1.0 / opt_.patch_recapture_scale) {
@@ -372,6 +370,8 @@ TrackedFrame StereoTracker::process(const StereoFrame& frame, std::optional<Eige
   std::vector<cv::Point2f> prev_px;
   std::vector<Track> tracks = track_temporal(curr, R_prev_curr_cam0, &prev_px, &out.stats);
   if (opt_.patch_refine) refine_with_patches(left, &tracks, &prev_px, &out.stats);
+  // Bearings once the pixels are final (the lift iterates for distorted lenses).
+  for (auto& t : tracks) t.bearing = cam0_->lift(to_eigen(t.px));
   if (opt_.f_ransac) reject_with_f(&tracks, &prev_px, &out.stats);
   enforce_spacing_and_detect(left, &tracks, &prev_px, &out.stats);
 

@@ -222,6 +222,24 @@ Eigen::MatrixXd denseJacobian(ceres::Problem& problem, const std::vector<double*
   return j;
 }
 
+/// Gauss-Newton H = J^T J and b = J^T r of all `factors` (loss-corrected, as Ceres evaluates them), the
+/// columns in the order of `order`: the dense reference the marginalization is checked against.
+struct DenseSystem {
+  Eigen::MatrixXd H;
+  Eigen::VectorXd b;
+};
+DenseSystem denseSystem(const std::vector<TestFactor>& factors, const std::vector<double*>& blocks,
+                        const std::vector<double*>& order) {
+  ceres::Problem problem(nonOwningOptions());
+  addRemainingFactors(problem, factors, blocks, {});
+  const Eigen::MatrixXd J = denseJacobian(problem, order);
+  std::vector<double> gradient;
+  ceres::Problem::EvaluateOptions eo;
+  eo.parameter_blocks = order;
+  problem.Evaluate(eo, nullptr, nullptr, &gradient, nullptr);
+  return {J.transpose() * J, Eigen::Map<const Eigen::VectorXd>(gradient.data(), static_cast<Eigen::Index>(gradient.size()))};
+}
+
 /// Linear chain x0..x4 (size 3): prior on x0 and x4, odometry x_i -> x_{i+1}, loops x0-x2 and x1-x3.
 std::vector<TestFactor> linearChain(std::mt19937& rng) {
   auto sqrtInfo = [&rng] { return Eigen::MatrixXd(2.0 * Eigen::MatrixXd::Identity(3, 3) + randomMatrix(3, 3, rng, 0.5)); };
@@ -505,15 +523,7 @@ TEST_CASE("Robust losses enter the prior exactly as Ceres' own Gauss-Newton syst
   };
   const std::vector<double*> blocks{x.data(), y.data()};
 
-  ceres::Problem problem(nonOwningOptions());
-  addRemainingFactors(problem, factors, blocks, {});
-  const Eigen::MatrixXd J = denseJacobian(problem, blocks);
-  std::vector<double> gradient;
-  ceres::Problem::EvaluateOptions eo;
-  eo.parameter_blocks = blocks;
-  problem.Evaluate(eo, nullptr, nullptr, &gradient, nullptr);
-  const Eigen::MatrixXd H = J.transpose() * J;
-  const Eigen::VectorXd b = Eigen::Map<const Eigen::VectorXd>(gradient.data(), 4);
+  const auto [H, b] = denseSystem(factors, blocks, blocks);
   const Eigen::Matrix2d h_star = H.bottomRightCorner<2, 2>() - H.bottomLeftCorner<2, 2>() * H.topLeftCorner<2, 2>().inverse() * H.topRightCorner<2, 2>();
   const Eigen::Vector2d b_star = b.tail<2>() - H.bottomLeftCorner<2, 2>() * H.topLeftCorner<2, 2>().inverse() * b.head<2>();
 
@@ -573,17 +583,9 @@ TEST_CASE("Scalar dropped blocks (inverse depths) are eliminated to the same Sch
     REQUIRE(info->keptBlocks() == std::vector<double*>{k0.data(), k1.data()});
 
     // Reference: Ceres' own Jacobian and gradient, Schur complement with a pseudo-inverse of H_mm.
-    ceres::Problem problem(nonOwningOptions());
-    addRemainingFactors(problem, factors, blocks, {});
     std::vector<double*> order;  // dropped first, then kept
     for (int i : {0, 3, 4, 5, 6, 7, 8, 1, 2}) order.push_back(blocks[i]);
-    const Eigen::MatrixXd J = denseJacobian(problem, order);
-    std::vector<double> gradient;
-    ceres::Problem::EvaluateOptions eo;
-    eo.parameter_blocks = order;
-    problem.Evaluate(eo, nullptr, nullptr, &gradient, nullptr);
-    const Eigen::MatrixXd H = J.transpose() * J;
-    const Eigen::VectorXd b = Eigen::Map<const Eigen::VectorXd>(gradient.data(), H.rows());
+    const auto [H, b] = denseSystem(factors, blocks, order);
     const int m = 9, n = 5;
     const Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> eig(H.topLeftCorner(m, m));
     const Eigen::VectorXd inv = (eig.eigenvalues().array() > 1e-8).select(eig.eigenvalues().array().inverse(), 0.0);
