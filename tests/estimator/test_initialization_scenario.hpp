@@ -24,6 +24,9 @@ struct ScenarioOptions {
   bool pure_rotation = false;
   /// Straight line at 3 m/s, no acceleration (rotations as usual): the metric scale is not observable.
   bool constant_velocity = false;
+  /// Straight line accelerating at a constant 1 m/s^2 from 1 m/s: the free gravity absorbs the
+  /// acceleration, so the scale is not observable either.
+  bool constant_acceleration = false;
   /// Feature ids i * 2^32 + 1 instead of i: all equal once truncated to 32 bits.
   bool wide_ids = false;
   double pixel_noise_px = 0.0;  ///< std of the observation noise [px] at focal 460
@@ -64,7 +67,8 @@ struct Scenario {
   }
 };
 
-inline sim::SmoothTrajectory scenarioTrajectory(bool pure_rotation, bool constant_velocity = false) {
+inline sim::SmoothTrajectory scenarioTrajectory(bool pure_rotation, bool constant_velocity = false,
+                                                bool constant_acceleration = false) {
   std::vector<sim::Waypoint> w;
   for (int i = 0; i <= 12; ++i) {
     const double t = 0.25 * i;
@@ -72,6 +76,8 @@ inline sim::SmoothTrajectory scenarioTrajectory(bool pure_rotation, bool constan
     p.t = t;
     if (constant_velocity)
       p.p = Eigen::Vector3d(3.0 * t, 0.0, 0.0);
+    else if (constant_acceleration)
+      p.p = Eigen::Vector3d(1.0 * t + 0.5 * t * t, 0.0, 0.0);
     else if (!pure_rotation)
       p.p = Eigen::Vector3d(0.8 * t + 0.3 * std::sin(3.0 * t), 0.4 * std::sin(2.2 * t), 0.25 * std::sin(2.7 * t));
     p.yaw = 0.4 * std::sin(1.3 * t);
@@ -84,7 +90,7 @@ inline sim::SmoothTrajectory scenarioTrajectory(bool pure_rotation, bool constan
 
 inline Scenario makeScenario(const ScenarioOptions& o = {}) {
   Scenario s;
-  s.traj = scenarioTrajectory(o.pure_rotation, o.constant_velocity);
+  s.traj = scenarioTrajectory(o.pure_rotation, o.constant_velocity, o.constant_acceleration);
   // Camera looking along body x (body x forward, y left, z up; camera z forward, x right, y down).
   s.R_bc << 0, 0, 1, -1, 0, 0, 0, -1, 0;
   s.p_bc = Eigen::Vector3d(0.05, 0.02, -0.01);

@@ -72,6 +72,20 @@ LinearSystem buildSystem(const std::vector<Eigen::Matrix3d>& R, const std::vecto
 
 }  // namespace
 
+double accelerometerExcitation(const std::vector<Eigen::Matrix3d>& R_c0_b,
+                               const std::vector<const ImuPreintegration*>& preints) {
+  std::vector<Eigen::Vector3d> f;
+  for (size_t k = 0; k < preints.size() && k < R_c0_b.size(); ++k)
+    if (preints[k]->sumDt() > 0.0) f.push_back(R_c0_b[k] * preints[k]->deltaV() / preints[k]->sumDt());
+  if (f.size() < 2) return 0.0;
+  Eigen::Vector3d mean = Eigen::Vector3d::Zero();
+  for (const Eigen::Vector3d& x : f) mean += x;
+  mean /= static_cast<double>(f.size());
+  double ss = 0.0;
+  for (const Eigen::Vector3d& x : f) ss += (x - mean).squaredNorm();
+  return std::sqrt(ss / static_cast<double>(f.size()));
+}
+
 Eigen::Matrix<double, 3, 2> gravityTangentBasis(const Eigen::Vector3d& g) {
   const Eigen::Vector3d a = g.normalized();
   // Any axis not parallel to g seeds the basis.
@@ -96,6 +110,14 @@ VisualInertialAlignment alignVisualInertial(const std::vector<Eigen::Matrix3d>& 
   const int frames = static_cast<int>(R_c0_b.size());
   if (frames < 3) {
     res.reason = "alignment needs at least 3 frames";
+    return res;
+  }
+
+  res.excitation = accelerometerExcitation(R_c0_b, preints);
+  if (o.min_excitation > 0.0 && !(res.excitation >= o.min_excitation)) {
+    res.reason = "alignment: accelerometer excitation " + std::to_string(res.excitation) + " m/s^2 (need " +
+                 std::to_string(o.min_excitation) + "): the acceleration barely varies across the window, so the "
+                 "scale is not observable";
     return res;
   }
 

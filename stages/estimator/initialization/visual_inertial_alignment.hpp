@@ -28,6 +28,13 @@ struct VisualInertialAlignmentOptions {
   /// the window solve refines a rough scale; on the simulated street (0.5 s windows) good windows read
   /// 0.18-0.27 and degenerate ones 0.4-75. <= 0: no check.
   double max_scale_relative_std = 0.3;
+  /// The window's accelerometer excitation (accelerometerExcitation()) must reach this [m/s^2]. The free
+  /// gravity absorbs any constant acceleration, so only the acceleration's variation across the window
+  /// carries the scale; when that variation is as small as the accelerometer's own error (bias drift,
+  /// noise: a few 0.01 m/s^2), the scale is noise, however well it fits (the scale-std test above does
+  /// not see it, since the visual track and the IMU then agree for any scale). Not in VINS-Mono, which
+  /// only logs its excitation check. <= 0: no check.
+  double min_excitation = 0.1;
 };
 
 /// Result of alignVisualInertial().
@@ -38,6 +45,7 @@ struct VisualInertialAlignment {
   Eigen::Vector3d g_c0 = Eigen::Vector3d::Zero();   ///< gravity acceleration in c0, |g| = gravity_norm
   double free_gravity_norm = 0.0;              ///< |g| of the unconstrained solution (before refinement)
   double scale_relative_std = 0.0;             ///< std(s) / s of the refined solution
+  double excitation = 0.0;                     ///< accelerometerExcitation() of the window [m/s^2]
   std::vector<Eigen::Vector3d> v_b;            ///< velocity of frame k expressed in body frame k [m/s]
 };
 
@@ -49,6 +57,11 @@ VisualInertialAlignment alignVisualInertial(const std::vector<Eigen::Matrix3d>& 
                                             const std::vector<const ImuPreintegration*>& preints,
                                             const Eigen::Vector3d& p_bc,
                                             const VisualInertialAlignmentOptions& options = {});
+
+/// RMS deviation, over the window's intervals, of each interval's mean specific force expressed in c0
+/// (R_c0_b[k] β_k / Δt_k) from their average [m/s^2]: how much the acceleration varies across the window.
+double accelerometerExcitation(const std::vector<Eigen::Matrix3d>& R_c0_b,
+                               const std::vector<const ImuPreintegration*>& preints);
 
 /// Two unit vectors spanning the plane orthogonal to g (VINS-Mono's TangentBasis).
 Eigen::Matrix<double, 3, 2> gravityTangentBasis(const Eigen::Vector3d& g);
