@@ -14,6 +14,7 @@
 #include "stages/estimator/marginalization/marginalization_factor.hpp"
 #include "stages/estimator/marginalization/marginalization_info.hpp"
 #include "stages/estimator/pose_manifold.hpp"
+#include "stages/estimator/window_gauge.hpp"
 
 namespace dynavins::estimator {
 
@@ -177,6 +178,7 @@ double WindowOptimizer::featureResidual(const WindowState& s, const WindowFeatur
 SolveStats WindowOptimizer::solve(WindowState& s, int newest, WindowFeatures& features) {
   SolveStats st;
   const auto t_ba = Clock::now();
+  const WindowGauge gauge = WindowGauge::of(s);
 
   ceres::Problem::Options po;
   po.cost_function_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
@@ -278,6 +280,7 @@ SolveStats WindowOptimizer::solve(WindowState& s, int newest, WindowFeatures& fe
       ++f->times_solved;
     }
   }
+  gauge.restore(s, newest);
   st.ba_ms = msSince(t_ba);
   return st;
 }
