@@ -8,9 +8,11 @@
 
 #include <Eigen/Geometry>
 
+#include "stages/common/so3.hpp"
 #include "stages/estimator/initialization/gravity_alignment.hpp"
 #include "stages/estimator/window_gauge.hpp"
 
+using namespace dynavins;
 using namespace dynavins::estimator;
 
 namespace {
@@ -24,8 +26,7 @@ WindowState randomWindow(uint64_t seed, double pitch0 = 0.1) {
   for (int k = 0; k <= kWindow; ++k) {
     s.p(k) = Eigen::Vector3d(30.0 + 3.0 * k + u(rng), -5.0 + u(rng), 2.0 + 0.2 * u(rng));
     const double pitch = k == 0 ? pitch0 : 0.1 * u(rng);
-    s.q(k) = Eigen::AngleAxisd(0.7 + 0.2 * u(rng), Eigen::Vector3d::UnitZ()) *
-             Eigen::AngleAxisd(pitch, Eigen::Vector3d::UnitY()) * Eigen::AngleAxisd(0.1 * u(rng), Eigen::Vector3d::UnitX());
+    s.q(k) = Eigen::Quaterniond(so3::fromYawPitchRoll(0.7 + 0.2 * u(rng), pitch, 0.1 * u(rng)));
     s.v(k) = Eigen::Vector3d(3.0 + u(rng), u(rng), 0.1 * u(rng));
   }
   return s;
