@@ -317,13 +317,18 @@ def seed_variants(runs):
     return [""] + extra
 
 
+def both_ok(a, b):
+    """Both runs exist and completed."""
+    return a is not None and b is not None and a.status == "ok" and b.status == "ok"
+
+
 def degradation_over_seeds(runs, mode, ba):
     """(mean ATE none, mean ATE high, their ratio) over the seed draws, None when any run failed:
     a failed run is not averaged away."""
     none, high = [], []
     for v in seed_variants(runs):
         a, b = runs.get(("none", mode, ba, v)), runs.get(("high", mode, ba, v))
-        if a is None or b is None or a.status != "ok" or b.status != "ok":
+        if not both_ok(a, b):
             return None
         none.append(a.ate)
         high.append(b.ate)
@@ -339,7 +344,7 @@ def table_degradation_seeds(runs):
             cells = []
             for v in seeds:
                 a, b = runs.get(("none", mode, ba, v)), runs.get(("high", mode, ba, v))
-                r = None if a is None or b is None or a.status != "ok" or b.status != "ok" else b.ate / a.ate
+                r = b.ate / a.ate if both_ok(a, b) else None
                 cells.append(f"{ate_cell(a)} → {ate_cell(b)} ({'✗' if r is None else fmt(r, 2)})")
             m = degradation_over_seeds(runs, mode, ba)
             cells.append("✗" if m is None else f"{fmt(m[0])} → {fmt(m[1])} (**{fmt(m[2], 2)}**)")
@@ -376,12 +381,12 @@ def feature_rows(runs, scenarios):
             sc = feature_scores(path)
             if sc["moving"] == 0:
                 continue  # nothing moves in this scene
-            sc.update(separable_moving(r, path))
+            sc.update(scores_against_true_poses(r, path))
             rows.append((s, tag, sc, r.status))
     return rows
 
 
-def separable_moving(run, features_csv):
+def scores_against_true_poses(run, features_csv):
     """Scores against what the true poses allow (static_point_fit.py): the moving features no static
     point explains (r_j > λw) and the recall among them; the static features whose track a static point
     does explain and the share of them kept."""
