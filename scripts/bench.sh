@@ -97,11 +97,10 @@ timed() {
 }
 
 # run_one SCENARIO MODE BA [VARIANT --set k=v ...]; the scene comes from bench/cache/$scene_cache
-# (default SCENARIO + the quick suffix)
 run_one() {
   local sc=$1 mode=$2 ba=$3; shift 3
   local variant=${1:-}; [ $# -gt 0 ] && shift
-  local data=bench/cache/${scene_cache:-$sc$suffix}/euroc
+  local data=bench/cache/$scene_cache/euroc
   local dir=$out/runs/$sc/$mode-$ba${variant:+-$variant}
   local cmd=("$bin" run --config "$data/vins_config.yaml" --euroc "$data" --ba "$ba" --rate 0
              --set max_solver_time=1000 "$@" --out "$dir")
@@ -111,30 +110,40 @@ run_one() {
   record run "$sc" "$mode" "$ba" "${variant:--}" "$status" "$wall" "$dir" "${cmd[*]}"
 }
 
-for sc in "${scenarios[@]}"; do
-  gen=(env CACHE_AS="$sc$suffix" DYNAVINS="$bin" scripts/cached-sim.sh "$sc" "${sim_args[@]}" --euroc)
-  timed "generate $sc$suffix" "$out/runs/generate-$sc.log" "${gen[@]}"
-  record generate "$sc" - - - "$status" "$wall" "bench/cache/$sc$suffix" "${gen[*]}"
+# not_run SCENARIO MODE BA VARIANT: a run whose scene could not be generated (recorded, never dropped)
+not_run() {
+  step=$((step + 1))
+  record run "$1" "$2" "$3" "${4:--}" "no-data" 0 "$out/runs/$1/$2-$3${4:+-$4}" "(scene not generated)"
+}
+
+# scene_runs SCENARIO VARIANT [SIM_ARGS...]: generates the scene into bench/cache/$scene_cache (once),
+# then runs it in the four configurations (as VARIANT); returns 1, with the runs recorded as not run,
+# when the scene could not be generated.
+scene_runs() {
+  local sc=$1 variant=$2 mode ba generated=1; shift 2
+  local log=$out/runs/generate-$sc${variant:+-$variant}.log
+  local gen=(env CACHE_AS="$scene_cache" DYNAVINS="$bin" scripts/cached-sim.sh "$sc" "$@" --euroc)
+  timed "generate $scene_cache" "$log" "${gen[@]}"
+  record generate "$sc" - - "${variant:--}" "$status" "$wall" "bench/cache/$scene_cache" "${gen[*]}"
   if [ "$status" != ok ] && [ "$status" != cached ]; then
-    echo "bench: generating $sc failed (see $out/runs/generate-$sc.log); its runs are recorded as failed" >&2
-    for mode in stereo mono; do for ba in huber dynavins; do
-      step=$((step + 1))
-      record run "$sc" "$mode" "$ba" - "no-data" 0 "$out/runs/$sc/$mode-$ba" "(scene not generated)"
-    done; done
-    if [ "$sc" = "$ablation_scene" ]; then
-      step=$((step + 1))
-      record run "$sc" stereo dynavins nomomentum "no-data" 0 "$out/runs/$sc/stereo-dynavins-nomomentum" "(scene not generated)"
-    fi
-    continue
+    echo "bench: generating $scene_cache failed (see $log); its runs are recorded as failed" >&2
+    generated=0
   fi
   for mode in stereo mono; do
     for ba in huber dynavins; do
-      run_one "$sc" "$mode" "$ba"
+      if [ "$generated" = 1 ]; then run_one "$sc" "$mode" "$ba" "$variant"; else not_run "$sc" "$mode" "$ba" "$variant"; fi
     done
   done
-  if [ "$sc" = "$ablation_scene" ]; then
+  [ "$generated" = 1 ]
+}
+
+for sc in "${scenarios[@]}"; do
+  scene_cache=$sc$suffix
+  if scene_runs "$sc" "" "${sim_args[@]}"; then
     # Table I: regularisation only (the paper's λm = 0 ablation)
-    run_one "$sc" stereo dynavins nomomentum --set momentum_on=0
+    [ "$sc" = "$ablation_scene" ] && run_one "$sc" stereo dynavins nomomentum --set momentum_on=0
+  else
+    [ "$sc" = "$ablation_scene" ] && not_run "$sc" stereo dynavins nomomentum
   fi
 done
 
@@ -144,19 +153,7 @@ done
 for seed in "${extra_seeds[@]}"; do
   for sc in none high; do
     scene_cache=$sc$suffix-s$seed
-    gen=(env CACHE_AS="$scene_cache" DYNAVINS="$bin" scripts/cached-sim.sh "$sc" "${sim_args[@]}" --seed "$seed" --euroc)
-    timed "generate $sc seed $seed" "$out/runs/generate-$sc-s$seed.log" "${gen[@]}"
-    record generate "$sc" - - "seed$seed" "$status" "$wall" "bench/cache/$scene_cache" "${gen[*]}"
-    for mode in stereo mono; do
-      for ba in huber dynavins; do
-        if [ "$status" = ok ] || [ "$status" = cached ]; then
-          run_one "$sc" "$mode" "$ba" "seed$seed"
-        else
-          step=$((step + 1))
-          record run "$sc" "$mode" "$ba" "seed$seed" "no-data" 0 "$out/runs/$sc/$mode-$ba-seed$seed" "(scene not generated)"
-        fi
-      done
-    done
+    scene_runs "$sc" "seed$seed" "${sim_args[@]}" --seed "$seed" || true
   done
 done
 unset scene_cache
