@@ -38,7 +38,7 @@ if [ "$quick" = 1 ]; then
   out=${out:-bench/results/quick}
   extra_seeds=()
 else
-  scenarios=(none low mid high night dynamic_follow temporal_static e_shape)
+  scenarios=(none low mid high night mav_none mav_high dynamic_follow temporal_static e_shape)
   sim_args=()
   suffix=""
   out=${out:-bench/results}

@@ -74,7 +74,12 @@ SmoothTrajectory fitTumTrajectory(const std::string& path, const TumFitOptions& 
   const int removed = removePositionJumps(poses, o.glitch_acceleration);
   if (removed > 0) spdlog::info("{}: removed {} position glitch(es) before fitting", path, removed);
   const double offset = o.shift_to_zero ? poses.front().t : 0.0;
-  for (TimedPose& s : poses) s.t -= offset;
+  const Eigen::Quaterniond q_world(o.world_from_file.linear()), q_body(o.file_body_from_body);
+  for (TimedPose& s : poses) {
+    s.t -= offset;
+    s.p = o.world_from_file * s.p;
+    s.q = (q_world * s.q * q_body).normalized();
+  }
   TrajectoryFitReport fr;
   SmoothTrajectory traj = fitTrajectory(poses, o.fit, &fr);
   if (report) {

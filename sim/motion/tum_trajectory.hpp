@@ -26,6 +26,11 @@ struct TumFitOptions {
   /// are removed by shifting the later samples; <= 0 disables. See removePositionJumps.
   double glitch_acceleration = 50.0;
   TrajectoryFitOptions fit;      ///< spline fit settings
+  /// Rigid placement applied to every sample before the fit: p' = world_from_file * p and
+  /// R' = world_from_file.R * R * file_body_from_body, i.e. the file's world put into ours and the body
+  /// axes renamed (the body origin stays where it was). Identity: the file as it is.
+  Eigen::Isometry3d world_from_file = Eigen::Isometry3d::Identity();
+  Eigen::Matrix3d file_body_from_body = Eigen::Matrix3d::Identity();
 };
 
 /// What fitTumTrajectory did.

@@ -4,6 +4,7 @@
 
 #include <spdlog/spdlog.h>
 
+#include "sim/motion/tum_trajectory.hpp"
 #include "sim/motion/waypoint_path.hpp"
 #include "sim/render/street_scene.hpp"
 
@@ -93,7 +94,40 @@ StereoRig StereoRig::standard() {
   return rig;
 }
 
+namespace {
+
+/// Recorded motion (motion.tum): the file's window fitted, its world turned by the placement's yaw and
+/// moved to its x, y, z, the body axes renamed so the rig's camera looks where the recorded one did.
+std::shared_ptr<const SmoothTrajectory> build_recorded_trajectory(const ScenarioSpec& spec) {
+  TumFitOptions o;
+  o.window_start = spec.tum_start;
+  o.window_duration = spec.duration > 0 ? spec.duration + 1.0 : 0.0;  // a little past the sequence's end
+  const Eigen::Vector4d& pl = spec.tum_placement;
+  o.world_from_file.linear() = Eigen::AngleAxisd(pl[3] * M_PI / 180.0, Eigen::Vector3d::UnitZ()).toRotationMatrix();
+  o.world_from_file.translation() = pl.head<3>();
+  if (spec.tum_body_axes == "euroc") {
+    // EuRoC's cam0 looks along the IMU's z, its x along the IMU's y, its y along the IMU's -x; our rig's
+    // camera looks along body x with x = -y_body, y = -z_body. Columns: our body axes in the IMU's frame.
+    o.file_body_from_body << 0, 0, 1,  //
+        0, -1, 0,                       //
+        1, 0, 0;
+  }
+  try {
+    TumFitReport report;
+    auto traj = std::make_shared<SmoothTrajectory>(fitTumTrajectory(spec.tum_file, o, &report));
+    spdlog::info("{}: fitted {} poses of {} (from {:.1f} s), RMS {:.1f} mm / {:.2f} deg", spec.file,
+                 report.fit.num_samples, spec.tum_file, spec.tum_start, report.fit.position_rms * 1e3,
+                 report.fit.rotation_rms * 180.0 / M_PI);
+    return traj;
+  } catch (const std::exception& e) {
+    throw std::runtime_error(spec.file + ": motion.tum: " + e.what());
+  }
+}
+
+}  // namespace
+
 std::shared_ptr<const SmoothTrajectory> build_body_trajectory(const ScenarioSpec& spec) {
+  if (!spec.tum_file.empty()) return build_recorded_trajectory(spec);
   std::vector<PathWaypoint> corners;
   for (const auto& w : spec.waypoints) {
     PathWaypoint p;

@@ -1,5 +1,6 @@
 #include "sim/scenario/scenario_spec.hpp"
 
+#include <filesystem>
 #include <set>
 #include <stdexcept>
 
@@ -124,12 +125,29 @@ ScenarioSpec load_scenario(const std::string& path) {
 
   const cv::FileNode motion = root["motion"];
   if (motion.empty()) r.fail("motion", "missing");
-  r.only(motion, "motion", {"profile", "cruise_speed", "waypoints"});
-  s.profile = r.text(motion, "profile", "drone", {"car", "drone", "handheld"});
-  s.cruise_speed = r.number(motion, "cruise_speed", false, 0);
-  const auto w = Reader{path}.numbers(motion, "waypoints", 3);
-  for (std::size_t i = 0; i < w.size(); i += 3) s.waypoints.emplace_back(w[i], w[i + 1], w[i + 2]);
-  if (s.waypoints.size() < 2) r.fail("motion.waypoints", "needs at least two (x, y, z) corners");
+  if (!motion["tum"].empty()) {
+    r.only(motion, "motion", {"tum", "tum_start", "placement", "body_axes"});
+    const std::string tum = r.text(motion, "tum", "", {});
+    if (tum.empty()) r.fail("motion.tum", "must name a TUM trajectory file");
+    // Relative paths are relative to the scenario file, so a scenario works from any directory.
+    const std::filesystem::path tp(tum);
+    s.tum_file = tp.is_absolute() ? tp.string() : (std::filesystem::path(path).parent_path() / tp).string();
+    s.tum_start = r.number(motion, "tum_start", false, 0);
+    if (s.tum_start < 0) r.fail("motion.tum_start", "must be >= 0");
+    if (!motion["placement"].empty()) {
+      const auto pl = r.numbers(motion, "placement", 4);
+      if (pl.size() != 4) r.fail("motion.placement", "must be [x, y, z, yaw_deg]");
+      s.tum_placement = Eigen::Vector4d(pl[0], pl[1], pl[2], pl[3]);
+    }
+    s.tum_body_axes = r.text(motion, "body_axes", "sim", {"sim", "euroc"});
+  } else {
+    r.only(motion, "motion", {"profile", "cruise_speed", "waypoints"});
+    s.profile = r.text(motion, "profile", "drone", {"car", "drone", "handheld"});
+    s.cruise_speed = r.number(motion, "cruise_speed", false, 0);
+    const auto w = Reader{path}.numbers(motion, "waypoints", 3);
+    for (std::size_t i = 0; i < w.size(); i += 3) s.waypoints.emplace_back(w[i], w[i + 1], w[i + 2]);
+    if (s.waypoints.size() < 2) r.fail("motion.waypoints", "needs at least two (x, y, z) corners");
+  }
 
   const cv::FileNode objects = root["objects"];
   if (!objects.empty()) {

@@ -41,6 +41,12 @@ struct ScenarioSpec {
   std::string profile = "drone";  ///< car | drone | handheld
   double cruise_speed = 0;        ///< [m/s]; 0 = the profile's
   std::vector<Eigen::Vector3d> waypoints;
+  // ... or recorded motion: a TUM trajectory (e.g. EuRoC ground truth) fitted and placed in the street,
+  // so the sim also runs the roll, pitch and shake of a real platform (motion.tum instead of waypoints).
+  std::string tum_file;     ///< resolved path of motion.tum; empty = waypoints
+  double tum_start = 0;     ///< [s] after the file's first pose
+  Eigen::Vector4d tum_placement = Eigen::Vector4d::Zero();  ///< x, y, z [m], yaw [deg] of the file's world in ours
+  std::string tum_body_axes = "sim";  ///< sim: camera along body x; euroc: along the IMU's z, as on the EuRoC MAV
   std::string photometric = "day";  ///< day | night
   std::vector<MovingObjectSpec> objects;
 };

@@ -1,9 +1,12 @@
 // Every scenario in bench/scenarios/ loads, builds and renders, and does what its file says it does.
+#include <algorithm>
+#include <cmath>
 #include <filesystem>
 
 #include <catch2/catch.hpp>
 #include <opencv2/core.hpp>
 
+#include "sim/motion/tum_trajectory.hpp"
 #include "sim/scenario/scenario.hpp"
 
 using namespace dynavins;
@@ -65,4 +68,33 @@ TEST_CASE("In `high` a truck covers most of the image for 1-3 s", "[scenario][fi
   INFO("frames with more than half the image moving: " << covered);
   CHECK(covered >= 20);  // >= 1 s at 20 Hz
   CHECK(covered <= 60);  // <= 3 s
+}
+
+TEST_CASE("The `mav` scenes fly EuRoC V1_02 with the camera where EuRoC's cam0 looked", "[scenario][files]") {
+  const auto spec = load_scenario((kScenarios / "mav_none.yaml").string());
+  REQUIRE(spec.tum_body_axes == "euroc");
+  const auto body = build_body_trajectory(spec);
+  const auto file = readTumTrajectory(spec.tum_file);
+  // cam0's axes in the EuRoC IMU frame: the rotation of T_BS in mav0/cam0/sensor.yaml.
+  Eigen::Matrix3d R_B_cam;
+  R_B_cam << 0.0148655429818, -0.999880929698, 0.00414029679422,  //
+      0.999557249008, 0.0149672133247, 0.025715529948,            //
+      -0.0257744366974, 0.00375618835797, 0.999660727178;
+  const StereoRig rig = StereoRig::standard();
+  const Eigen::Vector4d& pl = spec.tum_placement;
+  const Eigen::Matrix3d R_place = Eigen::AngleAxisd(pl[3] * M_PI / 180.0, Eigen::Vector3d::UnitZ()).toRotationMatrix();
+  for (double t : {3.0, 15.0, 27.0}) {
+    // The file's sample nearest to scenario time t (time 0 = the file's pose at tum_start).
+    const double t_file = file.front().t + spec.tum_start + t;
+    const auto it = std::min_element(file.begin(), file.end(), [t_file](const TimedPose& a, const TimedPose& b) {
+      return std::abs(a.t - t_file) < std::abs(b.t - t_file);
+    });
+    const Eigen::Matrix3d R_wc_euroc = R_place * it->q.toRotationMatrix() * R_B_cam;
+    const Eigen::Matrix3d R_wc_sim = body->rotation(t) * rig.T_body_cam0.linear();
+    INFO("t = " << t);
+    // Same viewing direction and image axes, up to the two rigs' small mounting tilts (~1.5 deg each).
+    CHECK(std::acos(R_wc_euroc.col(2).dot(R_wc_sim.col(2))) < 4.0 * M_PI / 180.0);
+    CHECK(std::acos(R_wc_euroc.col(0).dot(R_wc_sim.col(0))) < 4.0 * M_PI / 180.0);
+    CHECK((body->position(t) - (R_place * it->p + pl.head<3>())).norm() < 0.01);
+  }
 }

@@ -44,6 +44,31 @@ TEST_CASE("load_scenario reads every part of a scenario", "[scenario]") {
   CHECK(s.objects[3].poses[1][1] == 40);
 }
 
+TEST_CASE("load_scenario reads recorded motion, its path relative to the scenario file", "[scenario]") {
+  const auto path = write_yaml("tum.yaml",
+                               "name: t\nduration: 30\n"
+                               "motion: { tum: traj/V1.txt.gz, tum_start: 4, placement: [20, -1, 0.5, 90],"
+                               " body_axes: euroc }\n");
+  const ScenarioSpec s = load_scenario(path);
+  CHECK(s.tum_file == (fs::path(path).parent_path() / "traj/V1.txt.gz").string());
+  CHECK(s.tum_start == 4);
+  CHECK(s.tum_placement == Eigen::Vector4d(20, -1, 0.5, 90));
+  CHECK(s.tum_body_axes == "euroc");
+  CHECK(s.waypoints.empty());
+  const auto abs = write_yaml("tum_abs.yaml", "name: t\nmotion: { tum: /data/x.txt }\n");
+  CHECK(load_scenario(abs).tum_file == "/data/x.txt");
+  CHECK(load_scenario(abs).tum_body_axes == "sim");
+
+  auto p = write_yaml("tum_mix.yaml", "name: t\nmotion: { tum: x.txt, waypoints: [0, 0, 1, 5, 0, 1] }\n");
+  CHECK_THROWS_WITH(load_scenario(p), Catch::Contains("motion.waypoints: unknown key"));
+  p = write_yaml("tum_pl.yaml", "name: t\nmotion: { tum: x.txt, placement: [1, 2, 3] }\n");
+  CHECK_THROWS_WITH(load_scenario(p), Catch::Contains("placement"));
+  p = write_yaml("tum_axes.yaml", "name: t\nmotion: { tum: x.txt, body_axes: ned }\n");
+  CHECK_THROWS_WITH(load_scenario(p), Catch::Contains("'ned' is not one of"));
+  p = write_yaml("tum_start.yaml", "name: t\nmotion: { tum: x.txt, tum_start: -1 }\n");
+  CHECK_THROWS_WITH(load_scenario(p), Catch::Contains("motion.tum_start: must be >= 0"));
+}
+
 TEST_CASE("load_scenario: a wrong, unknown or missing key is an error naming key and file", "[scenario]") {
   const std::string motion = "motion: { waypoints: [0, 0, 1.5, 50, 0, 1.5] }\n";
   auto p = write_yaml("typo.yaml", "name: t\nsede: 3\n" + motion);

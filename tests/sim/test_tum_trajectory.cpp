@@ -207,6 +207,30 @@ TEST_CASE("fitTumTrajectory window, time shift and residual on real EuRoC data",
   CHECK_THROWS_AS(fitTumTrajectory(path, o), std::invalid_argument);
 }
 
+TEST_CASE("fitTumTrajectory places the file's world in ours and renames the body axes", "[sim][tum_trajectory]") {
+  const std::string path = kTraj + "euroc_tum/V1_02_medium.txt.gz";
+  TumFitOptions o;
+  o.window_start = 20.0;
+  o.window_duration = 5.0;
+  TumFitReport rep;
+  const SmoothTrajectory plain = fitTumTrajectory(path, o, &rep);
+  TumFitOptions placed = o;
+  placed.world_from_file.linear() = Eigen::AngleAxisd(0.7, Eigen::Vector3d::UnitZ()).toRotationMatrix();
+  placed.world_from_file.translation() = Eigen::Vector3d(20, -3, 0.5);
+  placed.file_body_from_body << 0, 0, 1, 0, -1, 0, 1, 0, 0;
+  const SmoothTrajectory moved = fitTumTrajectory(path, placed);
+  for (double t : {0.5, 2.0, 4.5}) {
+    INFO("t = " << t);
+    // The body origin moves with the world; the body axes are renamed, not moved.
+    CHECK((moved.position(t) - placed.world_from_file * plain.position(t)).norm() < 1e-6);
+    const Eigen::Matrix3d expect = placed.world_from_file.linear() * plain.rotation(t) * placed.file_body_from_body;
+    CHECK(Eigen::AngleAxisd(moved.rotation(t).transpose() * expect).angle() < 1e-6);
+    // The IMU sees the same motion in the renamed axes: ω_new = R_bodyᵀ ω_file.
+    CHECK((moved.angularVelocity(t) - placed.file_body_from_body.transpose() * plain.angularVelocity(t)).norm() <
+          1e-5);
+  }
+}
+
 TEST_CASE("fitTumTrajectory removes EuRoC MH_04's 13 cm ground-truth glitch", "[sim][tum_trajectory]") {
   // MH_04_difficult has a position step of 13 cm within 5 ms at 45.005 s after its start.
   const std::string path = kTraj + "euroc_tum/MH_04_difficult.txt.gz";
