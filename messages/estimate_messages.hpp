@@ -34,6 +34,8 @@ struct PoseEstimate {
 struct WeightedFeature {
   int64_t id = 0;
   float u = 0.f, v = 0.f;                                  ///< pixel in the newest left image
+  bool has_right = false;                                  ///< the newest observation has a right pixel
+  float u_r = 0.f, v_r = 0.f;                              ///< its pixel in the right image, when has_right
   Eigen::Vector3d p_w = Eigen::Vector3d::Zero();           ///< triangulated point in the world
   float weight = 1.f;                                      ///< w_j in [0, 1]
   int32_t times_solved = 0;                                ///< n_j

@@ -7,8 +7,10 @@ An object moving along the line of sight (a car far ahead, a truck that keeps pa
 looks exactly like a static point at another depth. This module measures that ceiling independently
 of the estimator: it fits the best static point to each feature's observed left-camera track
 (every frame of `features.csv`, not only one window) with the ground-truth poses, and returns its
-r_j in the estimator's units (σ = 1.5 px at 460 px, VINS-Fusion's). Stereo disparity is not in
-`features.csv`, so a near object moving with the camera may still be separable in stereo mode.
+r_j in the estimator's units (σ = 1.5 px at 460 px, VINS-Fusion's). For a stereo run, the right
+pixels of the same observations (`features.csv`'s u_r, v_r) join the fit with cam1's true poses: the
+disparity then also has to agree with one static point, which can separate an object that keeps pace
+with the camera (it looks like a point at infinity to the left camera alone).
 
 Only the simulator's pinhole-radtan cameras are handled (the scenes of this bench); numpy only.
 """
@@ -46,12 +48,12 @@ def read_pinhole(cam_yaml):
     return [_yaml_number(text, k) for k in ("fx", "fy", "cx", "cy", "k1", "k2", "p1", "p2")]
 
 
-def read_body_T_cam0(config_yaml):
-    """The 4x4 body_T_cam0 matrix of a VINS-Fusion config."""
+def read_body_T_cam(config_yaml, cam=0):
+    """The 4x4 body_T_cam<cam> matrix of a VINS-Fusion config."""
     text = open(config_yaml).read()
-    m = re.search(r"body_T_cam0\s*:.*?data\s*:\s*\[([^\]]*)\]", text, re.S)
+    m = re.search(rf"body_T_cam{cam}\s*:.*?data\s*:\s*\[([^\]]*)\]", text, re.S)
     if not m:
-        raise ValueError(f"{config_yaml}: no body_T_cam0")
+        raise ValueError(f"{config_yaml}: no body_T_cam{cam}")
     return np.array([float(x) for x in m.group(1).split(",")]).reshape(4, 4)
 
 
@@ -115,47 +117,65 @@ def best_static_residual(R_cw, p_wc, xy):
     return cost / len(xy)  # mean squared norm of the 2-D whitened residual, as r_j
 
 
-def camera_file(config_yaml):
-    """The cam0 calibration file a VINS-Fusion config names (cam0_calib, relative to the config)."""
-    m = re.search(r"^\s*cam0_calib\s*:\s*\"?([^\"\n]+)\"?", open(config_yaml).read(), re.M)
+def camera_file(config_yaml, cam=0):
+    """The cam<cam> calibration file a VINS-Fusion config names (cam0_calib, relative to the config)."""
+    m = re.search(rf"^\s*cam{cam}_calib\s*:\s*\"?([^\"\n]+)\"?", open(config_yaml).read(), re.M)
     if not m:
-        raise ValueError(f"{config_yaml}: no cam0_calib")
+        raise ValueError(f"{config_yaml}: no cam{cam}_calib")
     return os.path.join(os.path.dirname(config_yaml), m.group(1).strip())
+
+
+def _camera_poses(gt, ts, T_bc):
+    """World->camera rotations [N,3,3] and camera positions [N,3] at times ts (nearest ground truth)."""
+    t_gt = gt[:, 0]
+    i = np.clip(np.searchsorted(t_gt, ts), 0, len(t_gt) - 1)
+    i = np.where((i > 0) & (np.abs(t_gt[i - 1] - ts) < np.abs(t_gt[i] - ts)), i - 1, i)
+    R_wb = quaternion_matrices(gt[i, 4:8])
+    R_wc = R_wb @ T_bc[:3, :3]
+    p_wc = gt[i, 1:4] + np.einsum("nij,j->ni", R_wb, T_bc[:3, 3])
+    return np.transpose(R_wc, (0, 2, 1)), p_wc
 
 
 def track_residuals(features_csv, groundtruth_tum, config_yaml):
     """{feature_id: (r_j under the true poses, final sim_label)} for the features solved at least once
-    with a known label (the features the scoring counts)."""
-    cam = read_pinhole(camera_file(config_yaml))
-    T_bc = read_body_T_cam0(config_yaml)
+    with a known label (the features the scoring counts). Right pixels (stereo runs) join the fit."""
+    cam0 = read_pinhole(camera_file(config_yaml))
+    T_bc0 = read_body_T_cam(config_yaml, 0)
     gt = np.loadtxt(groundtruth_tum)
-    t_gt = gt[:, 0]
     tracks, last = defaultdict(list), {}
     with open(features_csv, newline="") as f:
         for row in csv.DictReader(f):
             fid = row["feature_id"]
-            tracks[fid].append((int(row["t_ns"]) * 1e-9, float(row["u"]), float(row["v"])))
+            right = (float(row["u_r"]), float(row["v_r"])) if row.get("u_r") else None
+            tracks[fid].append((int(row["t_ns"]) * 1e-9, float(row["u"]), float(row["v"]), right))
             last[fid] = (int(row["times_solved"]), int(row["sim_label"]))
+    stereo = any(r is not None for rows in tracks.values() for *_, r in rows)
+    if stereo:
+        cam1 = read_pinhole(camera_file(config_yaml, 1))
+        T_bc1 = read_body_T_cam(config_yaml, 1)
     out = {}
     for fid, (solved, label) in last.items():
         if solved == 0 or label < 0:
             continue
         # A row's (u, v) is the feature's latest observation in the window: the row's own frame only
         # while it is tracked; once lost (or its newest slot dropped) an older pixel is repeated. Every
-        # pixel first appears in the row of the frame that observed it: keep each pixel once, there.
+        # pixel first appears in the row of the frame that observed it: keep each pixel once, there,
+        # with the right pixel of that same row.
         obs, seen = {}, set()
-        for t, u, v in tracks[fid]:
+        for t, u, v, right in tracks[fid]:
             if (u, v) not in seen and t not in obs:
-                obs[t] = (u, v)
+                obs[t] = (u, v, right)
             seen.add((u, v))
         if len(obs) < 2:
             continue  # one frame: no track to judge
         ts = np.array(sorted(obs))
-        i = np.clip(np.searchsorted(t_gt, ts), 0, len(t_gt) - 1)
-        i = np.where((i > 0) & (np.abs(t_gt[i - 1] - ts) < np.abs(t_gt[i] - ts)), i - 1, i)
-        R_wb = quaternion_matrices(gt[i, 4:8])
-        R_wc = R_wb @ T_bc[:3, :3]
-        p_wc = gt[i, 1:4] + np.einsum("nij,j->ni", R_wb, T_bc[:3, 3])
-        xy = undistort(np.array([obs[t] for t in ts]), cam)
-        out[fid] = (best_static_residual(np.transpose(R_wc, (0, 2, 1)), p_wc, xy), label)
+        R_cw, p_wc = _camera_poses(gt, ts, T_bc0)
+        xy = undistort(np.array([obs[t][:2] for t in ts]), cam0)
+        if stereo:
+            tr = np.array([t for t in ts if obs[t][2] is not None])
+            if len(tr):
+                R1, p1 = _camera_poses(gt, tr, T_bc1)
+                R_cw, p_wc = np.concatenate((R_cw, R1)), np.concatenate((p_wc, p1))
+                xy = np.concatenate((xy, undistort(np.array([obs[t][2] for t in tr]), cam1)))
+        out[fid] = (best_static_residual(R_cw, p_wc, xy), label)
     return out

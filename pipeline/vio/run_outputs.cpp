@@ -118,7 +118,7 @@ RunOutputs::RunOutputs(const std::string& dir) : dir_(dir) {
   open(features_, kFeatures);
   open(events_, kEvents);
   odometry_ << "# t[s] x y z qx qy qz qw (body in world, Tracking frames only)\n";
-  features_ << "t_ns,seq,feature_id,u,v,weight,times_solved,sim_label,x,y,z\n";
+  features_ << "t_ns,seq,feature_id,u,v,weight,times_solved,sim_label,x,y,z,u_r,v_r\n";
   events_ << "t_ns,seq,event\n";
 }
 
@@ -151,9 +151,12 @@ void RunOutputs::write(const estimator::WindowEstimate& e) {
   estimated_.poses.push_back(stamped(e.t_ns, e.state.p_wb, e.state.q_wb));
   char buf[320];
   for (const WeightedFeature& f : e.features.features) {
-    std::snprintf(buf, sizeof buf, "%" PRId64 ",%" PRId64 ",%" PRId64 ",%.3f,%.3f,%.6f,%d,%d,%.6f,%.6f,%.6f\n", e.t_ns,
-                  e.seq, f.id, f.u, f.v, f.weight, f.times_solved, static_cast<int>(f.sim_label), f.p_w.x(),
-                  f.p_w.y(), f.p_w.z());
+    int n = std::snprintf(buf, sizeof buf, "%" PRId64 ",%" PRId64 ",%" PRId64 ",%.3f,%.3f,%.6f,%d,%d,%.6f,%.6f,%.6f,",
+                          e.t_ns, e.seq, f.id, f.u, f.v, f.weight, f.times_solved, static_cast<int>(f.sim_label),
+                          f.p_w.x(), f.p_w.y(), f.p_w.z());
+    // Right pixel of the same observation; both fields empty when it has none (mono, or no stereo match).
+    n += f.has_right ? std::snprintf(buf + n, sizeof buf - n, "%.3f,%.3f\n", f.u_r, f.v_r)
+                     : std::snprintf(buf + n, sizeof buf - n, ",\n");
     features_ << buf;
     ++totals_.feature_rows;
   }

@@ -291,6 +291,11 @@ void SlidingWindowEstimator::Impl::fillOutput(WindowEstimate& e) {
     wf.id = id;
     wf.u = static_cast<float>(f.obs.back().px.x());
     wf.v = static_cast<float>(f.obs.back().px.y());
+    wf.has_right = f.obs.back().has_right;  // never in mono mode (the window keeps no right observations)
+    if (wf.has_right) {
+      wf.u_r = static_cast<float>(f.obs.back().px_right.x());
+      wf.v_r = static_cast<float>(f.obs.back().px_right.y());
+    }
     wf.p_w = a.R * (Eigen::Vector3d(f.obs[0].xy.x(), f.obs[0].xy.y(), 1.0) / f.inv_depth) + a.p;
     wf.weight = static_cast<float>(mode.loss == BaLoss::Dynavins ? f.weight : 1.0);
     wf.times_solved = f.times_solved;

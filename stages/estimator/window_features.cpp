@@ -12,6 +12,7 @@ bool WindowFeatures::addFrame(int slot, const TrackedFrame& frame, double min_pa
     o.px = tf.px;
     o.has_right = use_right && tf.has_right;
     o.xy_right = tf.xy_right;
+    o.px_right = tf.px_right;
     auto it = features_.find(tf.id);
     if (it == features_.end() || it->second.endSlot() != slot - 1) {
       // New to the window (or a gap in its track, which ids never have): anchor it here.

@@ -26,6 +26,7 @@ struct FeatureObservation {
   Eigen::Vector2d px = Eigen::Vector2d::Zero();  ///< left pixel
   bool has_right = false;
   Eigen::Vector2d xy_right = Eigen::Vector2d::Zero();  ///< cam1, z = 1 plane
+  Eigen::Vector2d px_right = Eigen::Vector2d::Zero();  ///< right pixel (outputs and scoring only)
 };
 
 struct WindowFeature {

@@ -1,8 +1,8 @@
 #!/usr/bin/python3
 """bench/report/static_point_fit.py against constructed tracks with known truth: a static point fits
 (r_j ~ 0, also without parallax), a point crossing the view does not, a point receding along the line
-of sight is indistinguishable from a static one, and stale rows of features.csv are not taken as
-observations. Run with Debian's python (numpy): /usr/bin/python3 tests/bench/test_static_point_fit.py"""
+of sight is indistinguishable from a static one, stale rows of features.csv are not taken as
+observations, and a stereo run's right pixels separate a point that keeps pace with the camera. Run with Debian's python (numpy): /usr/bin/python3 tests/bench/test_static_point_fit.py"""
 import os
 import sys
 import tempfile
@@ -73,6 +73,31 @@ def main():
         check(fits["1"][0] < 1e-6, "stale rows after the track ends do not count as observations")
         check(fits["2"][0] > 1.0, "the crossing feature is separable")
         check(abs(spf.read_pinhole(cam)[0] - 400.0) < 1e-12, "camera read from the config's cam0_calib")
+
+        # Stereo: cam1 0.5 m to the right of cam0 (body = cam0). A point 8 m ahead that keeps pace with
+        # the camera never moves in the left image, so a point at infinity explains the left track; its
+        # disparity (400 * 0.5 / 8 = 25 px) does not agree with infinity. A static point stays explained.
+        open(cfg, "a").write('cam1_calib: "cam0.yaml"\nbody_T_cam1: !!opencv-matrix\n'
+                             "   rows: 4\n   cols: 4\n   dt: d\n   data: [1,0,0,0.5, 0,1,0,0, 0,0,1,0, 0,0,0,1]\n")
+        pacing = np.array([[1.0, 0.5, 8.0]]) + p_wc
+        rows = ["t_ns,seq,feature_id,u,v,weight,times_solved,sim_label,x,y,z,u_r,v_r"]
+        for fid, label, pts in ((1, 0, static), (4, 2, pacing)):
+            uv = observe(pts, p_wc) * 400.0 + np.array([320.0, 240.0])
+            uv_r = observe(pts, p_wc + np.array([0.5, 0.0, 0.0])) * 400.0 + np.array([320.0, 240.0])
+            for k in range(n):
+                # the pacing point's left pixel never changes: give it sub-pixel tracking jitter so that
+                # every row is a new observation, as a real track's would be
+                jitter = 1e-3 * k if fid == 4 else 0.0
+                rows.append(f"{t_ns[k]},{k},{fid},{uv[k, 0] + jitter:.6f},{uv[k, 1]:.6f},0.9,{k + 1},{label},0,0,0,"
+                            f"{uv_r[k, 0] + jitter:.6f},{uv_r[k, 1]:.6f}")
+        open(feats, "w").write("\n".join(rows) + "\n")
+        stereo = spf.track_residuals(feats, gt, cfg)
+        check(stereo["1"][0] < 1e-6, "stereo: a static point still fits its left and right pixels")
+        check(stereo["4"][0] > 1.0, "stereo: a point keeping pace is separable by its disparity")
+        left_only = os.path.join(tmp, "left_only.csv")
+        open(left_only, "w").write("\n".join(",".join(r.split(",")[:11]) for r in rows) + "\n")
+        check(spf.track_residuals(left_only, gt, cfg)["4"][0] < 1e-3,
+              "without right pixels the same pacing point looks static (a point at infinity)")
 
 
 if __name__ == "__main__":
