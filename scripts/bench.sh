@@ -3,7 +3,7 @@
 # estimator on each in every mode that matters, then writes the report (bench/report/make_report.py).
 # Usage: scripts/bench.sh [--quick] [--out DIR]
 #   full  (make bench):       every scenario of bench/scenarios at full length (40-85 s), and `none`
-#                             and `high` again at noise seeds 12 and 13 -> bench/results/
+#                             and `high` again at noise seeds 12 to 17 -> bench/results/
 #   quick (make bench-quick): `none` and `high` cut to 20 s (cached as NAME-20s) -> bench/results/quick/
 # Every run: `dynavins run --rate 0 --set max_solver_time=1000` (lossless replay, solves bounded by
 # iterations only), so accuracy does not depend on machine load. A failed run is recorded as failed
@@ -38,11 +38,11 @@ if [ "$quick" = 1 ]; then
   out=${out:-bench/results/quick}
   extra_seeds=()
 else
-  scenarios=(none low mid high night mav_none mav_high dynamic_follow temporal_static e_shape)
+  scenarios=(none low mid high night mav_none mav_high standstill_none standstill_high dynamic_follow temporal_static e_shape)
   sim_args=()
   suffix=""
   out=${out:-bench/results}
-  extra_seeds=(12 13)  # besides each scenario file's own seed (11)
+  extra_seeds=(12 13 14 15 16 17)  # besides each scenario file's own seed (11)
 fi
 ablation_scene=high
 overlay_scene=high
