@@ -34,7 +34,7 @@ demo: build
 # The benchmark suite (scripts/bench.sh): every scenario generated once (cached in bench/cache/), the
 # estimator run on each stereo and mono, Huber and DynaVINS, plus the momentum ablation on `high`;
 # writes bench/results/REPORT.md with its figures and rewrites the README's headline table.
-# About 35 min on this 2-core machine. bench-quick: `none` and `high` cut to 20 s, a few minutes,
+# About 35-50 min on this 2-core machine (35 min of runs at fd547cd, scenes cached). bench-quick: `none` and `high` cut to 20 s, a few minutes,
 # report in bench/results/quick/REPORT.md (the README is left alone).
 bench: build
 	DYNAVINS=$(BUILD)/bin/dynavins BENCH_TRACKER=$(BUILD)/bin/bench_tracker ./scripts/bench.sh
