@@ -49,6 +49,7 @@ SequentialVioResult runSequentialVio(io::SensorSource& source, const EstimatorOp
       if (e.status == estimator::EstimatorStatus::Reset) ++out.resets;
       if (e.status == estimator::EstimatorStatus::Tracking) {
         ++out.tracking_frames;
+        if (e.standstill) out.standstill_t_ns.push_back(e.t_ns);
         out.estimate.poses.push_back(stamped(e.t_ns, e.state.p_wb, e.state.q_wb));
         if (e.solve.alternations > 0) out.ba_ms.push_back(e.solve.ba_ms);
         for (const auto& wf : e.features.features) out.features[wf.id] = {wf.weight, wf.sim_label, wf.times_solved};
@@ -64,6 +65,7 @@ SequentialVioResult runSequentialVio(io::SensorSource& source, const EstimatorOp
       consume(imu.addImu(*s));
     } else if (auto* g = std::get_if<GroundTruthState>(&ev)) {
       out.ground_truth.poses.push_back(stamped(g->t_ns, g->p_wb, g->q_wb));
+      if (g->has_velocity) out.true_speed[g->t_ns] = g->v_wb.norm();
     } else if (auto* fr = std::get_if<StereoFrame>(&ev)) {
       StereoFrame frame = *fr;
       if (!mode.stereo) frame.right = cv::Mat();

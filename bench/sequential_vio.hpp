@@ -28,6 +28,8 @@ struct SequentialVioResult {
   std::vector<double> ba_ms;       ///< per window solve (all alternations)
   std::vector<double> tracker_ms;  ///< per frame
   int frames = 0, tracking_frames = 0, resets = 0;
+  std::vector<int64_t> standstill_t_ns;  ///< frames the estimator found at rest (zero-velocity factor)
+  std::map<int64_t, double> true_speed;  ///< |v_wb| of the source's ground truth, when it has velocities
 };
 
 /// Runs tracker -> IMU intervals -> estimator over every event of `source`. `on_tracked`, when set, sees

@@ -133,6 +133,7 @@ void RunOutputs::check(std::ofstream& f, const std::string& name) const {
 void RunOutputs::write(const estimator::WindowEstimate& e) {
   ++totals_.estimates;
   if (e.status == estimator::EstimatorStatus::Reset) ++totals_.resets;
+  if (e.standstill) ++totals_.standstill;
   totals_.frame_ms.push_back(e.solve.total_ms);
   if (e.solve.marginalization_ms > 0) totals_.marginalization_ms.push_back(e.solve.marginalization_ms);
   if (e.solve.alternations > 0) {
@@ -250,6 +251,7 @@ std::string summaryJson(const VioRunResult& run, const RunDescription& what, con
   j << "  \"estimator_frame_ms_p95\": " << num(percentile(totals.frame_ms, 95)) << ",\n";
   j << "  \"marginalization_ms_mean\": " << num(mean(totals.marginalization_ms)) << ",\n";
   j << "  \"resets\": " << totals.resets << ",\n";
+  j << "  \"standstill_frames\": " << totals.standstill << ",\n";
   j << "  \"estimator_events\": " << totals.events << ",\n";
   j << "  \"wall_s\": " << num(wall) << ",\n";
   j << "  \"data_s\": " << num(data) << ",\n";

@@ -32,6 +32,7 @@ struct RunDescription {
 /// What the summary reports about the estimates; filled while they are written.
 struct EstimateTotals {
   int64_t estimates = 0, tracking = 0, resets = 0, events = 0, feature_rows = 0;
+  int64_t standstill = 0;            ///< estimates found at rest (zero-velocity factor)
   std::vector<double> ba_ms;         ///< per estimate with alternations > 0
   std::vector<int> alternations;     ///< same estimates
   std::vector<double> frame_ms;          ///< the estimator's whole time per frame (every estimate)

@@ -110,6 +110,11 @@ EstimatorOptions EstimatorOptions::load(const std::string& path) {
     r.fail("alternating_converge", "must be in (0, 1] (fraction of converged weights)");
   l.opt("margin_feature_thresh", o.margin_feature_thresh);
   l.opt("weighted_huber", o.weighted_huber);
+  l.opt("zupt", o.zupt);
+  l.opt("zupt_max_velocity", o.zupt_max_velocity);
+  l.opt("zupt_max_disparity", o.zupt_max_disparity);
+  if (o.zupt_max_velocity < 0) r.fail("zupt_max_velocity", "must be non-negative [m/s]");
+  if (o.zupt_max_disparity < 0) r.fail("zupt_max_disparity", "must be non-negative [px]");
   if (o.margin_feature_thresh < 0 || o.margin_feature_thresh > 1) r.fail("margin_feature_thresh", "must be in [0, 1]");
   return o;
 }
@@ -167,6 +172,9 @@ std::string EstimatorOptions::print() const {
   line("alternating_converge", alternating_converge);
   line("margin_feature_thresh", margin_feature_thresh);
   line("weighted_huber", weighted_huber);
+  line("zupt", zupt);
+  line("zupt_max_velocity", zupt_max_velocity, " [m/s]");
+  line("zupt_max_disparity", zupt_max_disparity, " [px]");
   return s.str();
 }
 
@@ -287,6 +295,9 @@ void EstimatorOptions::apply(const std::string& key, const std::string& value) {
       {"margin_feature_thresh",
        real_in(&EstimatorOptions::margin_feature_thresh, 0, 1, false, "must be in [0, 1]")},
       {"weighted_huber", flag(&EstimatorOptions::weighted_huber)},
+      {"zupt", flag(&EstimatorOptions::zupt)},
+      {"zupt_max_velocity", real_in(&EstimatorOptions::zupt_max_velocity, 0, inf, false, "must be non-negative [m/s]")},
+      {"zupt_max_disparity", real_in(&EstimatorOptions::zupt_max_disparity, 0, inf, false, "must be non-negative [px]")},
   };
   if (fixed.count(key)) bad(key, "describes the sensor rig and cannot be overridden; edit the yaml");
   const auto it = setters.find(key);

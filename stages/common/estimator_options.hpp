@@ -69,6 +69,12 @@ struct EstimatorOptions {
   /// (dynavins mode). A weight judges a whole track; the Huber loss still bounds one bad observation of a
   /// kept track (a one-frame KLT slip). 0 gives the paper's eq. 4 exactly (weights replace the Huber loss).
   bool weighted_huber = true;
+  /// Ours, not the paper's: zero-velocity update (standstill_detector.hpp), with OpenVINS' key names and
+  /// defaults. A frame whose kept features show less than `zupt_max_disparity` px of rotation-compensated
+  /// motion while the last solve's speed is under `zupt_max_velocity` m/s has its velocity held at zero.
+  bool zupt = true;
+  double zupt_max_velocity = 0.1;  ///< m/s
+  double zupt_max_disparity = 0.5;  ///< px (median, at VINS' nominal 460 px focal length)
 
   std::set<std::string> keys_from_file;      ///< which options the file set (the rest are defaults)
   std::set<std::string> keys_from_override;  ///< which options a command line `--set key=value` set

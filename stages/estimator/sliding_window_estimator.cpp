@@ -11,6 +11,7 @@
 #include "stages/estimator/initialization/gravity_alignment.hpp"
 #include "stages/estimator/initialization/gyro_bias_estimator.hpp"
 #include "stages/estimator/initialization/mono_initializer.hpp"
+#include "stages/estimator/standstill_detector.hpp"
 #include "stages/estimator/window_features.hpp"
 #include "stages/estimator/window_optimizer.hpp"
 #include "stages/estimator/window_state.hpp"
@@ -34,6 +35,15 @@ WindowSolveOptions solveOptions(const EstimatorOptions& o, const EstimatorMode& 
   s.alternating_converge = o.alternating_converge;
   s.margin_feature_thresh = o.margin_feature_thresh;
   s.weighted_huber = o.weighted_huber;
+  s.zero_velocity_sigma = StandstillOptions().velocity_sigma;
+  return s;
+}
+
+StandstillOptions standstillOptions(const EstimatorOptions& o) {
+  StandstillOptions s;
+  s.enabled = o.zupt;
+  s.max_speed = o.zupt_max_velocity;
+  s.max_disparity_px = o.zupt_max_disparity;
   return s;
 }
 
@@ -364,16 +374,23 @@ WindowEstimate SlidingWindowEstimator::Impl::process(const TrackedFrame& frame, 
     spdlog::info("estimator initialised at t={:.3f} s ({} mode, {} BA)", frame.t_ns * 1e-9,
                  mode.stereo ? "stereo" : "mono", toString(mode.loss));
   } else {
+    // At rest? Judged on the IMU-predicted rotation and the last solve's weights and speed, before this solve.
+    const Eigen::Matrix3d R_prev_new = state.camera(newest - 1).R.transpose() * state.camera(newest).R;
+    const StandstillCheck rest = checkStandstill(features, newest, R_prev_new, Eigen::Vector3d(state.v(newest - 1)).norm(),
+                                                 standstillOptions(opt));
+    state.still[newest] = rest.still ? 1 : 0;
+    e.standstill = rest.still;
     features.triangulate(cams(), T_c0c1, mode.stereo);
     e.solve = optimizer.solve(state, newest, features);
     features.removeBadDepths();
     const std::string why = failureReason(last_p, last_q);
     if (!why.empty()) return fail(why);
   }
-  spdlog::debug("t={:.3f} p=({:.3f},{:.3f},{:.3f}) v=({:.3f},{:.3f},{:.3f}) ba={:.3f} bg={:.4f} ba_ms={:.1f} it={} alt={} feats={} kf={}",
+  spdlog::debug("t={:.3f} p=({:.3f},{:.3f},{:.3f}) v=({:.3f},{:.3f},{:.3f}) ba={:.3f} bg={:.4f} ba_ms={:.1f} it={} alt={} feats={} kf={} still={}",
                 frame.t_ns * 1e-9, state.p(newest).x(), state.p(newest).y(), state.p(newest).z(), state.v(newest).x(),
                 state.v(newest).y(), state.v(newest).z(), state.ba(newest).norm(), state.bg(newest).norm(), e.solve.ba_ms,
-                e.solve.ceres_iterations, e.solve.alternations, e.solve.features_in_window, keep_second_newest);
+                e.solve.ceres_iterations, e.solve.alternations, e.solve.features_in_window, keep_second_newest,
+                e.standstill);
   e.keyframe = keep_second_newest;
   fillOutput(e);
   const auto t_m = Clock::now();

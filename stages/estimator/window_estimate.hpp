@@ -33,6 +33,7 @@ struct WindowEstimate {
   EstimatorStatus status = EstimatorStatus::Initializing;
   NavState state;           ///< body in world at t_ns; valid when status == Tracking
   bool keyframe = false;    ///< the previous newest frame was kept as a keyframe (VINS' MARGIN_OLD)
+  bool standstill = false;  ///< found at rest: its velocity was held at zero (standstill_detector.hpp)
   WeightedFeatureSet features;  ///< window features, weights after this solve (Tracking only)
   SolveStats solve;
   std::string event;        ///< "initialized", "reset: <reason>", or empty

@@ -11,6 +11,7 @@
 
 #include "stages/estimator/factors/imu_factor.hpp"
 #include "stages/estimator/factors/reprojection_factors.hpp"
+#include "stages/estimator/factors/zero_velocity_factor.hpp"
 #include "stages/estimator/marginalization/marginalization_factor.hpp"
 #include "stages/estimator/marginalization/marginalization_info.hpp"
 #include "stages/estimator/pose_manifold.hpp"
@@ -211,6 +212,12 @@ SolveStats WindowOptimizer::solve(WindowState& s, int newest, WindowFeatures& fe
     problem.AddResidualBlock(cost.get(), nullptr, s.pose[k - 1].data(), s.speed_bias[k - 1].data(),
                              s.pose[k].data(), s.speed_bias[k].data());
   }
+  for (int k = 0; k <= newest; ++k) {
+    if (!s.still[k]) continue;
+    auto cost = std::make_shared<ZeroVelocityFactor>(opt_.zero_velocity_sigma);
+    costs.push_back(cost);
+    problem.AddResidualBlock(cost.get(), nullptr, s.speed_bias[k].data());
+  }
   std::vector<WindowFeature*> in_ba;
   for (auto& [id, f] : features.all()) {
     if (!f.inBa() || f.start_slot > newest) continue;
@@ -300,6 +307,7 @@ void WindowOptimizer::marginalizeOldest(WindowState& s, int newest, WindowFeatur
     info->add({std::make_shared<ImuFactor>(s.preint[1].get(), opt_.gravity), nullptr,
                {pose0, sb0, s.pose[1].data(), s.speed_bias[1].data()}, {0, 1}});
   }
+  if (s.still[0]) info->add({std::make_shared<ZeroVelocityFactor>(opt_.zero_velocity_sigma), nullptr, {sb0}, {0}});
   for (auto& [id, f] : features.all()) {
     if (f.start_slot != 0 || !f.inBa()) continue;
     // A feature the robust BA rejected would poison the prior forever (paper III; margin_feature_thresh).

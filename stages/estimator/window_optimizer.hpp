@@ -34,6 +34,7 @@ struct WindowSolveOptions {
   int max_alternations = 4;
   double margin_feature_thresh = 0.1;  ///< features under this weight stay out of the prior (dynavins)
   bool weighted_huber = true;  ///< dynavins: Huber loss on each weighted observation too (not the paper's)
+  double zero_velocity_sigma = 0.01;  ///< m/s, of the zero-velocity factor on slots found at rest
 };
 
 class WindowOptimizer {

@@ -19,7 +19,7 @@ namespace dynavins::estimator {
 
 struct WindowState {
   explicit WindowState(int window_size) : t_ns(window_size + 1), pose(window_size + 1), speed_bias(window_size + 1),
-                                          preint(window_size + 1) {
+                                          preint(window_size + 1), still(window_size + 1, 0) {
     for (auto& p : pose) p = {0, 0, 0, 0, 0, 0, 1};
     for (auto& s : speed_bias) s.fill(0.0);
   }
@@ -48,6 +48,7 @@ struct WindowState {
     pose[to] = pose[from];
     speed_bias[to] = speed_bias[from];
     preint[to] = std::move(preint[from]);
+    still[to] = still[from];
   }
 
   std::vector<int64_t> t_ns;
@@ -55,6 +56,7 @@ struct WindowState {
   std::vector<std::array<double, kSpeedBiasSize>> speed_bias;
   std::array<std::array<double, kPoseSize>, 2> extrinsic{};  ///< body_T_cam0, body_T_cam1
   std::vector<std::unique_ptr<ImuPreintegration>> preint;   ///< preint[k]: slot k-1 -> k (null at slot 0)
+  std::vector<uint8_t> still;  ///< 1: slot k was found at rest (standstill_detector.hpp); its velocity is held at 0
 };
 
 }  // namespace dynavins::estimator

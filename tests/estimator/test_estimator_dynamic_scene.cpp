@@ -45,6 +45,15 @@ TEST_CASE("truck crossing ahead: dynavins holds where huber does not", "[estimat
   const bench::WeightScore score = bench::scoreWeights(dyn.run.features);
   REQUIRE(score.moving > 50);  // the truck was seen and its features went through the BA
   CHECK(score.moving_rejected >= 0.9);
+  // The standstill detector (zero-velocity factor) never held a moving camera: at every frame it found at
+  // rest the true speed was under 0.2 m/s (twice its speed gate), though a truck filled the view.
+  REQUIRE(!dyn.run.true_speed.empty());
+  for (int64_t t : dyn.run.standstill_t_ns) {
+    const auto it = dyn.run.true_speed.lower_bound(t);
+    REQUIRE(it != dyn.run.true_speed.end());
+    INFO("standstill at t = " << t * 1e-9 << " s, true speed " << it->second << " m/s");
+    CHECK(it->second < 0.2);
+  }
 
   const Outcome hub = runScene(sc, estimator::BaLoss::Huber);
   INFO("huber ATE " << hub.ate << " m, resets " << hub.run.resets);
