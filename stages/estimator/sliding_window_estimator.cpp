@@ -35,7 +35,6 @@ WindowSolveOptions solveOptions(const EstimatorOptions& o, const EstimatorMode& 
   s.alternating_converge = o.alternating_converge;
   s.margin_feature_thresh = o.margin_feature_thresh;
   s.weighted_huber = o.weighted_huber;
-  s.zero_velocity_sigma = StandstillOptions().velocity_sigma;
   return s;
 }
 
@@ -376,8 +375,8 @@ WindowEstimate SlidingWindowEstimator::Impl::process(const TrackedFrame& frame, 
   } else {
     // At rest? Judged on the IMU-predicted rotation and the last solve's weights and speed, before this solve.
     const Eigen::Matrix3d R_prev_new = state.camera(newest - 1).R.transpose() * state.camera(newest).R;
-    const StandstillCheck rest = checkStandstill(features, newest, R_prev_new, Eigen::Vector3d(state.v(newest - 1)).norm(),
-                                                 standstillOptions(opt));
+    const StandstillCheck rest =
+        checkStandstill(features, newest, R_prev_new, state.v(newest - 1).norm(), standstillOptions(opt));
     state.still[newest] = rest.still ? 1 : 0;
     e.standstill = rest.still;
     features.triangulate(cams(), T_c0c1, mode.stereo);

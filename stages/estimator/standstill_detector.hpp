@@ -22,7 +22,6 @@ struct StandstillOptions {
   double max_speed = 0.1;         ///< m/s; OpenVINS' zupt_max_velocity
   int min_features = 20;
   double min_weight = 0.5;        ///< features below it (rejected by the robust BA) are not counted
-  double velocity_sigma = 0.01;   ///< m/s, of the zero-velocity factor
 };
 
 struct StandstillCheck {
