@@ -1,5 +1,6 @@
-// bench_estimator: one scenario, huber and dynavins side by side through the deterministic sequential
-// chain (tracker -> IMU -> estimator on one thread): ATE, feature scoring, BA ms.
+// bench_estimator: one scenario, huber and dynavins side by side through the shipped chain run on one
+// thread (runVioSequential: the stages of `dynavins run`, deterministic): ATE, feature scoring, BA ms, and
+// how far each static track strays from its true point.
 //   bench_estimator --scenario high [--duration S] [--mono] [--ba huber,dynavins]
 #include <filesystem>
 #include <sstream>
@@ -8,11 +9,12 @@
 #include <CLI/CLI.hpp>
 #include <spdlog/spdlog.h>
 
-#include "bench/scenario_options.hpp"
-#include "bench/sequential_vio.hpp"
 #include "eval/evaluation.hpp"
 #include "eval/trajectory_io.hpp"
+#include "pipeline/vio/estimate_recorder.hpp"
+#include "pipeline/vio/vio_pipeline.hpp"
 #include "sim/scenario/scenario.hpp"
+#include "sim/scenario/scenario_config.hpp"
 #include "sim/scenario/scenario_spec.hpp"
 
 using namespace dynavins;
@@ -72,14 +74,12 @@ int main(int argc, char** argv) {
   CLI::App app{"Huber vs DynaVINS on one simulated scenario (sequential, deterministic)"};
   std::string scenario = "high", modes = "huber,dynavins", level = "warn";
   std::optional<double> duration;
-  bool mono = false, solver_time_budget = false;
+  bool mono = false;
   std::string out_dir;
   app.add_option("--scenario", scenario, "Name in bench/scenarios or a file")->capture_default_str();
   app.add_option("--duration", duration, "Seconds to simulate (default: the scenario's)");
   app.add_option("--ba", modes, "Comma-separated BA losses")->capture_default_str();
   app.add_flag("--mono", mono, "Mono-inertial (cam0 only)");
-  app.add_flag("--solver-time-budget", solver_time_budget,
-               "Keep the config's max_solver_time (real-time behaviour; results then depend on machine load)");
   app.add_option("--log-level", level)->capture_default_str();
   app.add_option("--out", out_dir, "Write <ba>.tum and groundtruth.tum here");
   CLI11_PARSE(app, argc, argv);
@@ -88,28 +88,37 @@ int main(int argc, char** argv) {
   std::string path = scenario;
   if (!std::filesystem::is_regular_file(path)) path = std::string(DYNAVINS_SOURCE_DIR) + "/bench/scenarios/" + scenario + ".yaml";
   const auto sc = sim::build_scenario(sim::load_scenario(path), std::nullopt, duration);
-  EstimatorOptions opt = bench::scenarioEstimatorOptions(*sc);
-  // Iteration-bound solves (max_num_iterations only): with the config's wall-clock budget
-  // (max_solver_time) the answer would depend on how loaded the machine is.
-  if (!solver_time_budget) opt.max_solver_time = 1e3;
+  // Rate 0: iteration-bound solves (max_num_iterations only), so the answer does not depend on machine load.
+  pipeline::VioRunOptions opt;
+  opt.estimator = sim::scenarioEstimatorOptions(*sc);
+  opt.show_progress = false;
 
   std::stringstream ss(modes);
   std::string m;
   while (std::getline(ss, m, ',')) {
-    estimator::EstimatorMode mode;
-    mode.loss = estimator::parseBaLoss(m);
-    mode.stereo = !mono;
+    opt.mode.loss = estimator::parseBaLoss(m);
+    opt.mode.stereo = !mono;
     sim::ScenarioSource src(sc);
     TrackTruth truth(src, *sc);
-    const auto r = bench::runSequentialVio(src, opt, mode, [&truth](const TrackedFrame& f) { truth(f); });
+    pipeline::EstimateRecorder r;
+    pipeline::VioSinks sinks;
+    sinks.estimate = [&r](const estimator::WindowEstimate& e) { r.record(e); };
+    // Sequential: the tracker sees each frame while the source's last rendered frame (its depth) is it.
+    sinks.tracked = [&truth](const TrackedFrame& f) { truth(f); };
+    const pipeline::VioRunResult run = pipeline::runVioSequential(src, opt, sinks);
+    if (!run.report.ok) {
+      spdlog::error("{}: {} failed: {}", m, run.report.failed_thread, run.report.error);
+      return 1;
+    }
+    const eval::Trajectory ground_truth = pipeline::groundTruthTrajectory(run.ground_truth);
     if (!out_dir.empty()) {
       std::filesystem::create_directories(out_dir);
       eval::write_tum(out_dir + "/" + m + ".tum", r.estimate);
-      eval::write_tum(out_dir + "/groundtruth.tum", r.ground_truth);
+      eval::write_tum(out_dir + "/groundtruth.tum", ground_truth);
     }
     double ate = -1;
     try {
-      ate = eval::evaluate(r.ground_truth, r.estimate).ate.rmse;
+      ate = eval::evaluate(ground_truth, r.estimate).ate.rmse;
     } catch (const std::exception& e) {
       spdlog::warn("{}: no ATE: {}", m, e.what());
     }
@@ -119,7 +128,7 @@ int main(int argc, char** argv) {
     for (double v : ba) mean += v;
     mean = ba.empty() ? 0 : mean / ba.size();
     const double p95 = ba.empty() ? 0 : ba[static_cast<size_t>(0.95 * (ba.size() - 1))];
-    const auto sw = bench::scoreWeights(r.features);
+    const auto sw = eval::scoreWeights(r.features);
     std::printf("%-9s %s %s: ATE %.4f m | frames %d tracking %d resets %d | BA ms mean %.2f p95 %.2f | "
                 "moving %d rejected %.1f%% | static %d kept %.1f%%\n",
                 m.c_str(), scenario.c_str(), mono ? "mono" : "stereo", ate, r.frames, r.tracking_frames, r.resets,

@@ -19,6 +19,16 @@ struct StampedPose {
   Eigen::Quaterniond q = Eigen::Quaterniond::Identity();  // unit norm
 };
 
+/// The pose at `t_ns` (both time forms filled, `q` normalised).
+inline StampedPose stampedPose(std::int64_t t_ns, const Eigen::Vector3d& p, const Eigen::Quaterniond& q) {
+  StampedPose s;
+  s.t_ns = t_ns;
+  s.t = static_cast<double>(t_ns) * 1e-9;
+  s.p = p;
+  s.q = q.normalized();
+  return s;
+}
+
 /// A trajectory with strictly increasing time stamps; `source` names its file for messages.
 struct Trajectory {
   std::string source;

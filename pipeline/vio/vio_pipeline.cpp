@@ -1,19 +1,16 @@
 #include "pipeline/vio/vio_pipeline.hpp"
 
-#include <cmath>
+#include <chrono>
 #include <optional>
 #include <stdexcept>
 #include <utility>
-#include <variant>
 
 #include <spdlog/spdlog.h>
 
 #include "pipeline/emit.hpp"
-#include "pipeline/latest_value.hpp"
+#include "pipeline/interrupt.hpp"
 #include "pipeline/vio/frame_imu_attacher.hpp"
-#include "stages/estimator/estimator_input.hpp"
-#include "stages/tracker/gyro_rotation_predictor.hpp"
-#include "stages/tracker/stereo_tracker.hpp"
+#include "pipeline/vio/vio_stages.hpp"
 
 namespace dynavins::pipeline {
 namespace {
@@ -21,92 +18,50 @@ namespace {
 using estimator::EstimatorInput;
 using estimator::WindowEstimate;
 
-/// Tracker thread: the KLT front end; in mono mode the right image is ignored. With a predictor, each
-/// frame's KLT starts from the rotation its gyro samples give since the previous tracked frame.
-struct TrackerStage {
-  TrackerStage(StereoTracker t, bool mono_, std::optional<GyroRotationPredictor> g, LatestValue<Eigen::Vector3d>& b)
-      : tracker(std::move(t)), mono(mono_), gyro(std::move(g)), gyro_bias(b) {}
+/// The replay's hand-over, the same for both drivers: each frame's time goes to the IMU stage before the
+/// frame goes to the tracker, so the interval that ends at a frame is complete when the frame is. With
+/// gyro prediction a frame waits in `attacher` for the first IMU sample at or after it. Each push returns
+/// false when the run is aborted; `poll` runs before every event (stop requests).
+struct ReplayRouting {
+  bool predict = false;
+  std::function<bool(ImuStageInput)> push_imu;
+  std::function<bool(TrackerInput)> push_frame;
+  std::function<void()> poll;
+  std::vector<GroundTruthState>* ground_truth = nullptr;
+  FrameImuAttacher attacher;
 
-  StereoTracker tracker;
-  bool mono;
-  std::optional<GyroRotationPredictor> gyro;  ///< empty: prediction off
-  /// The estimator's newest gyro bias. A LatestValue has one reader and the IMU thread reads the
-  /// NavState one, so the estimator publishes the bias a second time, for this thread alone.
-  LatestValue<Eigen::Vector3d>& gyro_bias;
-  Eigen::Vector3d bias = Eigen::Vector3d::Zero();  // zero until the estimator tracks
-  std::optional<int64_t> prev_t_ns;
-  int64_t frames_predicted = 0, frames_unpredicted = 0, features_predicted = 0, features_tracked = 0;
-  int64_t features_lost_flow = 0, features_lost_back = 0;
+  bool pushAttached(std::optional<TrackerInput> f) { return !f || push_frame(std::move(*f)); }
 
-  TrackedFrame process(TrackerInput in) {
-    if (mono) in.frame.right = cv::Mat();
-    std::optional<Eigen::Matrix3d> R_prev_curr;
-    if (gyro) {
-      if (const auto b = gyro_bias.read()) bias = *b;
-      if (prev_t_ns) R_prev_curr = gyro->predict(in.imu, *prev_t_ns, in.frame.t_ns, bias);
-      ++(R_prev_curr ? frames_predicted : frames_unpredicted);
-    }
-    prev_t_ns = in.frame.t_ns;
-    TrackedFrame out = tracker.process(in.frame, R_prev_curr);
-    features_predicted += out.stats.predicted;
-    features_tracked += out.stats.tracked;
-    features_lost_flow += out.stats.lost_flow;
-    features_lost_back += out.stats.lost_back;
-    return out;
+  ReplaySinks sinks() {
+    ReplaySinks s;
+    s.frame = [this](StereoFrame&& f) {
+      poll();
+      if (!push_imu(FrameTime{f.t_ns})) return false;
+      if (!predict) return push_frame(TrackerInput{std::move(f), {}});
+      return pushAttached(attacher.addFrame(std::move(f)));
+    };
+    s.imu = [this](ImuSample&& x) {
+      poll();
+      if (!predict) return push_imu(std::move(x));
+      const ImuSample copy = x;
+      return push_imu(std::move(x)) && pushAttached(attacher.addImu(copy));
+    };
+    s.ground_truth = [this](GroundTruthState&& g) {
+      ground_truth->push_back(std::move(g));
+      return true;
+    };
+    return s;
   }
+  /// End of the replay: the frame still waiting for its IMU goes on without it.
+  void finish() { pushAttached(attacher.finish()); }
 };
 
-/// IMU thread: before each input, linearise at the estimator's newest biases (read without waiting).
-struct ImuThreadStage {
-  ImuStage stage;
-  LatestValue<NavState>& latest;
-  std::vector<PreintegratedInterval> process(ImuStageInput in) {
-    if (const auto s = latest.read()) stage.setBiases(s->bias_acc, s->bias_gyr);
-    return stage.process(in);
-  }
-};
-
-/// Estimator thread: pairs frames with their IMU, runs the window BA, publishes the newest state.
-struct EstimatorStage {
-  FrameImuPairer pairer;
-  estimator::SlidingWindowEstimator estimator;
-  LatestValue<NavState>& latest;
-  LatestValue<Eigen::Vector3d>& gyro_bias;  ///< the same state's gyro bias, for the tracker thread
-  int64_t tracking = 0, resets = 0;
-
-  std::vector<WindowEstimate> process(EstimatorInput in) {
-    std::vector<FrameWithImu> ready =
-        std::visit([this](auto&& x) -> std::vector<FrameWithImu> {
-          using T = std::decay_t<decltype(x)>;
-          if constexpr (std::is_same_v<T, TrackedFrame>) return pairer.addFrame(std::move(x));
-          else return pairer.addInterval(std::move(x));
-        }, std::move(in));
-    std::vector<WindowEstimate> out;
-    out.reserve(ready.size());
-    for (FrameWithImu& f : ready) {
-      out.push_back(estimator.process(f.frame, f.imu ? &*f.imu : nullptr));
-      const WindowEstimate& e = out.back();
-      if (e.status == estimator::EstimatorStatus::Tracking) {
-        ++tracking;
-        const NavState s = estimator.latestState();
-        latest.write(s);
-        gyro_bias.write(s.bias_gyr);
-      }
-      if (e.status == estimator::EstimatorStatus::Reset) ++resets;
-      if (!e.event.empty()) spdlog::info("estimator: t = {} ns: {}", e.t_ns, e.event);
-    }
-    return out;
-  }
-  void finish() { pairer.finish(); }
-};
-
-/// Writer thread: hands each estimate to the run's outputs.
-struct WriterStage {
-  const VioSinks& sinks;
-  void process(WindowEstimate e) {
-    if (sinks.estimate) sinks.estimate(e);
-  }
-};
+void countFrames(VioRunResult& result) {
+  for (const auto& q : result.report.queues)
+    if (q.name == "frames") result.frames_dropped = static_cast<int64_t>(q.dropped);
+  for (const auto& s : result.report.stages)
+    if (s.name == "tracker") result.frames_tracked = static_cast<int64_t>(s.processed);
+}
 
 }  // namespace
 
@@ -126,26 +81,7 @@ VioRunResult runVio(io::SensorSource& source, const VioRunOptions& opt, const Vi
   const bool paced = opt.rate > 0;
   VioRunResult result;
   result.source = source.describe();
-
-  const ImuStageOptions imu_options = ImuStageOptions::from(opt.estimator, opt.imu_rate_hz, opt.imu_noise);
-  std::optional<GyroRotationPredictor> gyro;
-  // estimate_extrinsic 2 lets a config leave body_T_cam0 out; the loader then stores identity, which is
-  // no calibration: a gyro rotation conjugated by it would seed the KLT in the wrong direction.
-  const bool extrinsic_known = opt.estimator.estimate_extrinsic != 2 || opt.estimator.keys_from_file.count("body_T_cam0");
-  if (opt.gyro_prediction && !extrinsic_known)
-    spdlog::warn("gyro prediction off: the config has no body_T_cam0 (estimate_extrinsic 2)");
-  const bool predict = opt.gyro_prediction && extrinsic_known;
-  // Same outage threshold as the IMU stage's interval builder.
-  if (predict)
-    gyro.emplace(opt.estimator.body_T_cam.at(0), std::llround(imu_options.gap_periods * 1e9 / imu_options.imu_rate_hz));
-  LatestValue<NavState> latest;
-  LatestValue<Eigen::Vector3d> gyro_bias;
-  TrackerStage tracker(StereoTracker(TrackerOptions::from(opt.estimator), opt.estimator.cameras[0],
-                                     opt.mode.stereo ? opt.estimator.cameras[1] : nullptr),
-                       !opt.mode.stereo, std::move(gyro), gyro_bias);
-  ImuThreadStage imu{ImuStage(imu_options), latest};
-  EstimatorStage est{FrameImuPairer{}, estimator::SlidingWindowEstimator(opt.estimator, opt.mode), latest, gyro_bias};
-  WriterStage writer{sinks};
+  VioStages st(opt, sinks.tracked, sinks.estimate);
 
   Pipeline p;
   auto& frames = p.add_queue<TrackerInput>("frames", opt.frame_queue, paced ? Backpressure::DropOldest : Backpressure::Block);
@@ -158,70 +94,100 @@ VioRunResult runVio(io::SensorSource& source, const VioRunOptions& opt, const Vi
   p.add_source(
       "replay",
       [&](const StopFlag& stop) {
-        auto stop_if_asked = [&] {
+        ReplayRouting route;
+        route.predict = st.predict;
+        route.ground_truth = &result.ground_truth;
+        route.poll = [&] {
           if (external_stop && external_stop->stop_requested() && !stop.stop_requested()) {
             spdlog::warn("stop requested: stopping the replay and draining the queues");
             p.request_stop();
           }
         };
         // IMU input is never dropped: paced, a full queue is an error rather than a silent wait.
-        auto push_imu = [&](ImuStageInput x) {
+        route.push_imu = [&](ImuStageInput x) {
           if (paced ? imu_in.try_push(std::move(x)) : imu_in.push(std::move(x))) return true;
           if (stop.aborted()) return false;
           throw std::runtime_error("IMU queue full: the IMU stage fell behind (IMU is never dropped)");
         };
-        // With prediction, a frame waits here for the first IMU sample at or after it (see FrameImuAttacher).
-        FrameImuAttacher attacher;
-        auto push_frame = [&](std::optional<TrackerInput> f) { return !f || frames.push(std::move(*f)); };
-        ReplaySinks s;
-        s.frame = [&](StereoFrame&& f) {
-          stop_if_asked();
-          if (!push_imu(FrameTime{f.t_ns})) return false;
-          if (!predict) return frames.push(TrackerInput{std::move(f), {}});
-          return push_frame(attacher.addFrame(std::move(f)));
-        };
-        s.imu = [&](ImuSample&& x) {
-          stop_if_asked();
-          if (!predict) return push_imu(std::move(x));
-          const ImuSample copy = x;
-          return push_imu(std::move(x)) && push_frame(attacher.addImu(copy));
-        };
-        s.ground_truth = [&](GroundTruthState&& g) {
-          result.ground_truth.push_back(std::move(g));
-          return true;
-        };
-        result.replay = replay(source, {opt.rate, opt.show_progress}, s, stop);
-        push_frame(attacher.finish());
+        route.push_frame = [&](TrackerInput f) { return frames.push(std::move(f)); };
+        result.replay = replay(source, {opt.rate, opt.show_progress}, route.sinks(), stop);
+        route.finish();
       },
       [&] {
         frames.close();
         imu_in.close();
       });
-  p.add_stage("tracker", tracker, frames, into(*from_tracker), [&] { from_tracker->close(); });
-  p.add_stage("imu", imu, imu_in, into(*from_imu), [&] { from_imu->close(); });
-  p.add_stage("estimator", est, est_in, into(estimates), [&] { estimates.close(); });
-  p.add_stage("writer", writer, estimates, NoOutput{}, {});
+  p.add_stage("tracker", st.tracker, frames, into(*from_tracker), [&] { from_tracker->close(); });
+  p.add_stage("imu", st.imu, imu_in, into(*from_imu), [&] { from_imu->close(); });
+  p.add_stage("estimator", st.estimator, est_in, into(estimates), [&] { estimates.close(); });
+  p.add_stage("writer", st.writer, estimates, NoOutput{}, {});
 
   result.report = p.run();
+  countFrames(result);
+  st.collect(result);
+  return result;
+}
 
-  for (const auto& q : result.report.queues)
-    if (q.name == "frames") result.frames_dropped = static_cast<int64_t>(q.dropped);
-  for (const auto& s : result.report.stages) {
-    if (s.name == "tracker") result.frames_tracked = static_cast<int64_t>(s.processed);
+VioRunResult runVioSequential(io::SensorSource& source, const VioRunOptions& opt, const VioSinks& sinks,
+                              const StopFlag* external_stop) {
+  checkVioOptions(opt);
+  if (opt.rate != 0) throw std::invalid_argument("the sequential run replays as fast as possible: rate must be 0");
+  VioRunResult result;
+  result.source = source.describe();
+  VioStages st(opt, sinks.tracked, sinks.estimate);
+
+  const char* stage = "replay";  // the stage running now, for the report of a failure
+  auto toEstimator = [&](EstimatorInput in) {
+    stage = "estimator";
+    for (WindowEstimate& e : st.estimator.process(std::move(in))) {
+      stage = "writer";
+      st.writer.process(std::move(e));
+    }
+    stage = "replay";
+  };
+  StopFlag stop;
+  bool interrupted = false;
+  ReplayRouting route;
+  route.predict = st.predict;
+  route.ground_truth = &result.ground_truth;
+  route.poll = [&] {
+    const bool asked = (external_stop && external_stop->stop_requested()) || interrupt_requested();
+    if (asked && !stop.stop_requested()) {
+      spdlog::warn("stop requested: stopping the replay");
+      interrupted = true;
+      stop.request_stop();
+    }
+  };
+  route.push_imu = [&](ImuStageInput x) {
+    stage = "imu";
+    for (PreintegratedInterval& iv : st.imu.process(std::move(x))) toEstimator(std::move(iv));
+    stage = "replay";
+    return true;
+  };
+  int64_t tracked = 0;
+  route.push_frame = [&](TrackerInput f) {
+    stage = "tracker";
+    TrackedFrame t = st.tracker.process(std::move(f));
+    ++tracked;
+    toEstimator(std::move(t));
+    return true;
+  };
+
+  const auto t0 = std::chrono::steady_clock::now();
+  try {
+    result.replay = replay(source, {0.0, opt.show_progress}, route.sinks(), stop);
+    route.finish();
+    stage = "estimator";
+    st.estimator.finish();
+  } catch (const std::exception& e) {
+    result.report.ok = false;
+    result.report.failed_thread = stage;
+    result.report.error = e.what();
   }
-  result.gyro_prediction = predict;
-  result.frames_gyro_predicted = tracker.frames_predicted;
-  result.frames_gyro_unpredicted = tracker.frames_unpredicted;
-  result.features_gyro_predicted = tracker.features_predicted;
-  result.features_tracked = tracker.features_tracked;
-  result.features_lost_flow = tracker.features_lost_flow;
-  result.features_lost_back = tracker.features_lost_back;
-  result.frames_estimated = est.pairer.stats().emitted;
-  result.frames_tracking = est.tracking;
-  result.resets = est.resets;
-  result.imu = imu.stage.stats();
-  result.imu_builder = imu.stage.builderStats();
-  result.pairer = est.pairer.stats();
+  result.report.wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  result.report.interrupted = interrupted;
+  result.frames_tracked = tracked;
+  st.collect(result);
   return result;
 }
 

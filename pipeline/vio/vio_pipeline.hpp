@@ -15,6 +15,11 @@
 // rate 0: every queue blocks (lossless, repeatable); rate > 0: the frame queue drops the oldest frames
 // when the tracker falls behind (counted). IMU is never dropped: a full IMU queue in real time is an error.
 // End of input, SIGINT or a stop request drain every queue before runVio() returns.
+//
+// runVioSequential() is the same run on the caller's thread (Kimera-VIO's spinSequential beside
+// launchThreads): the same stages (vio_stages.hpp), built the same way, fed in the replay's order, with no
+// queues between them. At rate 0 both give the same trajectory bit for bit (tests/vio/test_vio_sequential.cpp);
+// tests and benches that need one answer every time, or a hook after the tracker, use it.
 
 #include <cstddef>
 #include <cstdint>
@@ -23,6 +28,7 @@
 #include <vector>
 
 #include "io/sensor_source.hpp"
+#include "messages/tracked_frame.hpp"
 #include "pipeline/pipeline.hpp"
 #include "pipeline/replay.hpp"
 #include "pipeline/stop_flag.hpp"
@@ -51,9 +57,13 @@ struct VioRunOptions {
   bool gyro_prediction = false;
 };
 
-/// Where the estimates go; called on the writer thread, one call per processed frame, in time order.
+/// Where the results go. Threaded: `estimate` is called on the writer thread, `tracked` on the tracker
+/// thread; sequential: both on the caller's. Either may be empty.
 struct VioSinks {
+  /// One call per processed frame, in time order.
   std::function<void(const estimator::WindowEstimate&)> estimate;
+  /// Every tracked frame, right after the tracker (e.g. to score tracks against simulator truth).
+  std::function<void(const TrackedFrame&)> tracked;
 };
 
 /// Everything a run measured; the stage counters are read after all threads have ended.
@@ -70,6 +80,9 @@ struct VioRunResult {
   /// dropped frame or an IMU outage), and features whose KLT converged from the prediction (all 0 when off;
   /// TrackerStats::predicted, counted before the min-distance mask, so it may exceed features_tracked).
   bool gyro_prediction = false;
+  /// Whether the config's max_solver_time bounded the window solves (paced runs); at rate 0 only the
+  /// iteration budget does, so the result does not depend on the machine's speed or load.
+  bool solver_time_budget = true;
   int64_t frames_gyro_predicted = 0;
   int64_t frames_gyro_unpredicted = 0;
   int64_t features_gyro_predicted = 0;
@@ -94,5 +107,11 @@ void checkVioOptions(const VioRunOptions& options);
 /// a thread is returned in result.report (ok == false, error, failed_thread).
 VioRunResult runVio(io::SensorSource& source, const VioRunOptions& options, const VioSinks& sinks,
                     const StopFlag* external_stop = nullptr);
+
+/// The same run on the caller's thread, one input at a time in the replay's order (rate must be 0).
+/// Stops at the source's end, SIGINT or `external_stop`. A stage's exception is returned in result.report
+/// like runVio's (failed_thread names the stage); result.report.stages/queues stay empty.
+VioRunResult runVioSequential(io::SensorSource& source, const VioRunOptions& options, const VioSinks& sinks,
+                              const StopFlag* external_stop = nullptr);
 
 }  // namespace dynavins::pipeline

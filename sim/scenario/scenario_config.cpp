@@ -1,18 +1,18 @@
-#include "bench/scenario_options.hpp"
+#include "sim/scenario/scenario_config.hpp"
 
 #include <unistd.h>
 
 #include <filesystem>
 
-namespace dynavins::bench {
+namespace dynavins::sim {
 
-EstimatorOptions scenarioEstimatorOptions(const sim::Scenario& scenario) {
+EstimatorOptions scenarioEstimatorOptions(const Scenario& scenario) {
   namespace fs = std::filesystem;
   const fs::path dir = fs::temp_directory_path() / ("dynavins_scenario_config_" + std::to_string(::getpid()));
-  io::write_vins_stereo_config(dir.string(), sim::vins_config(scenario));
+  io::write_vins_stereo_config(dir.string(), vins_config(scenario));
   EstimatorOptions opt = EstimatorOptions::load((dir / "vins_config.yaml").string());
   fs::remove_all(dir);  // the camera models are loaded; the files are no longer needed
   return opt;
 }
 
-}  // namespace dynavins::bench
+}  // namespace dynavins::sim

@@ -5,8 +5,8 @@
 #include "sim/scenario/scenario.hpp"
 #include "stages/common/estimator_options.hpp"
 
-namespace dynavins::bench {
+namespace dynavins::sim {
 
-EstimatorOptions scenarioEstimatorOptions(const sim::Scenario& scenario);
+EstimatorOptions scenarioEstimatorOptions(const Scenario& scenario);
 
-}  // namespace dynavins::bench
+}  // namespace dynavins::sim

@@ -1,0 +1,123 @@
+#include "pipeline/vio/vio_stages.hpp"
+
+#include <cmath>
+#include <limits>
+#include <type_traits>
+#include <utility>
+#include <variant>
+
+#include <spdlog/spdlog.h>
+
+#include "pipeline/vio/vio_pipeline.hpp"
+
+namespace dynavins::pipeline {
+
+TrackerStage::TrackerStage(StereoTracker t, bool mono_, std::optional<GyroRotationPredictor> g,
+                           LatestValue<Eigen::Vector3d>& b, std::function<void(const TrackedFrame&)> cb)
+    : tracker(std::move(t)), mono(mono_), gyro(std::move(g)), gyro_bias(b), on_tracked(std::move(cb)) {}
+
+TrackedFrame TrackerStage::process(TrackerInput in) {
+  if (mono) in.frame.right = cv::Mat();
+  std::optional<Eigen::Matrix3d> R_prev_curr;
+  if (gyro) {
+    if (const auto b = gyro_bias.read()) bias = *b;
+    if (prev_t_ns) R_prev_curr = gyro->predict(in.imu, *prev_t_ns, in.frame.t_ns, bias);
+    ++(R_prev_curr ? frames_predicted : frames_unpredicted);
+  }
+  prev_t_ns = in.frame.t_ns;
+  TrackedFrame out = tracker.process(in.frame, R_prev_curr);
+  features_predicted += out.stats.predicted;
+  features_tracked += out.stats.tracked;
+  features_lost_flow += out.stats.lost_flow;
+  features_lost_back += out.stats.lost_back;
+  if (on_tracked) on_tracked(out);
+  return out;
+}
+
+std::vector<PreintegratedInterval> ImuFeedbackStage::process(ImuStageInput in) {
+  if (const auto s = latest.read()) stage.setBiases(s->bias_acc, s->bias_gyr);
+  return stage.process(in);
+}
+
+std::vector<estimator::WindowEstimate> EstimatorStage::process(estimator::EstimatorInput in) {
+  std::vector<FrameWithImu> ready =
+      std::visit([this](auto&& x) -> std::vector<FrameWithImu> {
+        using T = std::decay_t<decltype(x)>;
+        if constexpr (std::is_same_v<T, TrackedFrame>) return pairer.addFrame(std::move(x));
+        else return pairer.addInterval(std::move(x));
+      }, std::move(in));
+  std::vector<estimator::WindowEstimate> out;
+  out.reserve(ready.size());
+  for (FrameWithImu& f : ready) {
+    out.push_back(estimator.process(f.frame, f.imu ? &*f.imu : nullptr));
+    const estimator::WindowEstimate& e = out.back();
+    if (e.status == estimator::EstimatorStatus::Tracking) {
+      ++tracking;
+      const NavState s = estimator.latestState();
+      latest.write(s);
+      gyro_bias.write(s.bias_gyr);
+    }
+    if (e.status == estimator::EstimatorStatus::Reset) ++resets;
+    if (!e.event.empty()) spdlog::info("estimator: t = {} ns: {}", e.t_ns, e.event);
+  }
+  return out;
+}
+
+namespace {
+
+// estimate_extrinsic 2 lets a config leave body_T_cam0 out; the loader then stores identity, which is no
+// calibration: a gyro rotation conjugated by it would seed the KLT in the wrong direction.
+bool gyroPredictionUsable(const VioRunOptions& o) {
+  const bool extrinsic_known = o.estimator.estimate_extrinsic != 2 || o.estimator.keys_from_file.count("body_T_cam0");
+  if (o.gyro_prediction && !extrinsic_known)
+    spdlog::warn("gyro prediction off: the config has no body_T_cam0 (estimate_extrinsic 2)");
+  return o.gyro_prediction && extrinsic_known;
+}
+
+std::optional<GyroRotationPredictor> gyroPredictor(const VioRunOptions& o, bool predict) {
+  if (!predict) return std::nullopt;
+  // Same outage threshold as the IMU stage's interval builder.
+  const ImuStageOptions imu = ImuStageOptions::from(o.estimator, o.imu_rate_hz, o.imu_noise);
+  return GyroRotationPredictor(o.estimator.body_T_cam.at(0), std::llround(imu.gap_periods * 1e9 / imu.imu_rate_hz));
+}
+
+// As fast as possible (rate 0) the run must not depend on how fast or loaded the machine is, so each
+// window solve is bounded by its iteration budget alone; the config's wall-clock budget
+// (max_solver_time) applies to paced runs, where the estimator must keep up.
+EstimatorOptions estimatorOptions(const VioRunOptions& o) {
+  EstimatorOptions e = o.estimator;
+  if (o.rate <= 0) e.max_solver_time = std::numeric_limits<double>::infinity();
+  return e;
+}
+
+}  // namespace
+
+VioStages::VioStages(const VioRunOptions& o, std::function<void(const TrackedFrame&)> on_tracked,
+                     std::function<void(const estimator::WindowEstimate&)> on_estimate)
+    : predict(gyroPredictionUsable(o)),
+      solver_time_budget(o.rate > 0),
+      tracker(StereoTracker(TrackerOptions::from(o.estimator), o.estimator.cameras.at(0),
+                            o.mode.stereo ? o.estimator.cameras.at(1) : nullptr),
+              !o.mode.stereo, gyroPredictor(o, predict), gyro_bias, std::move(on_tracked)),
+      imu{ImuStage(ImuStageOptions::from(o.estimator, o.imu_rate_hz, o.imu_noise)), latest},
+      estimator{FrameImuPairer{}, estimator::SlidingWindowEstimator(estimatorOptions(o), o.mode), latest, gyro_bias},
+      writer{std::move(on_estimate)} {}
+
+void VioStages::collect(VioRunResult& r) const {
+  r.gyro_prediction = predict;
+  r.solver_time_budget = solver_time_budget;
+  r.frames_gyro_predicted = tracker.frames_predicted;
+  r.frames_gyro_unpredicted = tracker.frames_unpredicted;
+  r.features_gyro_predicted = tracker.features_predicted;
+  r.features_tracked = tracker.features_tracked;
+  r.features_lost_flow = tracker.features_lost_flow;
+  r.features_lost_back = tracker.features_lost_back;
+  r.frames_estimated = estimator.pairer.stats().emitted;
+  r.frames_tracking = estimator.tracking;
+  r.resets = estimator.resets;
+  r.imu = imu.stage.stats();
+  r.imu_builder = imu.stage.builderStats();
+  r.pairer = estimator.pairer.stats();
+}
+
+}  // namespace dynavins::pipeline

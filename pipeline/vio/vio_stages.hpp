@@ -1,0 +1,110 @@
+#pragma once
+// The stages of the visual-inertial run (DESIGN.md §2) as plain objects, each `process(input) -> output`
+// (Kimera-VIO's PipelineModule without its thread): the threaded driver (runVio) puts each on its own
+// thread, the sequential driver (runVioSequential) calls them one after the other on the caller's thread.
+// Both build them here, from the same options, so the path users run is the path the tests check.
+//
+//   tracker:   StereoFrame (+ its gyro samples) -> TrackedFrame
+//   imu:       ImuSample | FrameTime -> PreintegratedInterval*      (linearised at the estimator's biases)
+//   estimator: TrackedFrame | PreintegratedInterval -> WindowEstimate*  (pairs them, runs the window BA)
+//   writer:    WindowEstimate -> the run's sinks
+// Feedback: the estimator publishes its newest NavState to the IMU stage and its gyro bias to the tracker
+// through LatestValue snapshots (never waited on).
+
+#include <cstdint>
+#include <functional>
+#include <optional>
+#include <vector>
+
+#include <Eigen/Core>
+
+#include "messages/tracked_frame.hpp"
+#include "pipeline/latest_value.hpp"
+#include "pipeline/vio/frame_imu_attacher.hpp"
+#include "stages/estimator/estimator_input.hpp"
+#include "stages/estimator/sliding_window_estimator.hpp"
+#include "stages/estimator/window_estimate.hpp"
+#include "stages/imu/frame_imu_pairer.hpp"
+#include "stages/imu/imu_stage.hpp"
+#include "stages/tracker/gyro_rotation_predictor.hpp"
+#include "stages/tracker/stereo_tracker.hpp"
+
+namespace dynavins::pipeline {
+
+struct VioRunOptions;
+struct VioRunResult;
+
+/// Tracker: the KLT front end; in mono mode the right image is ignored. With a predictor, each frame's
+/// KLT starts from the rotation its gyro samples give since the previous tracked frame.
+struct TrackerStage {
+  TrackerStage(StereoTracker t, bool mono, std::optional<GyroRotationPredictor> g,
+               LatestValue<Eigen::Vector3d>& gyro_bias,
+               std::function<void(const TrackedFrame&)> on_tracked);
+
+  TrackedFrame process(TrackerInput in);
+
+  StereoTracker tracker;
+  bool mono;
+  std::optional<GyroRotationPredictor> gyro;  ///< empty: prediction off
+  /// The estimator's newest gyro bias. A LatestValue has one reader and the IMU stage reads the
+  /// NavState one, so the estimator publishes the bias a second time, for this stage alone.
+  LatestValue<Eigen::Vector3d>& gyro_bias;
+  std::function<void(const TrackedFrame&)> on_tracked;  ///< may be empty (VioSinks::tracked)
+  Eigen::Vector3d bias = Eigen::Vector3d::Zero();  // zero until the estimator tracks
+  std::optional<int64_t> prev_t_ns;
+  int64_t frames_predicted = 0, frames_unpredicted = 0, features_predicted = 0, features_tracked = 0;
+  int64_t features_lost_flow = 0, features_lost_back = 0;
+};
+
+/// IMU stage: before each input, linearise at the estimator's newest biases (read without waiting). The
+/// estimator re-propagates an interval whose biases differ from its own, so the estimate does not depend
+/// on which biases were current here.
+struct ImuFeedbackStage {
+  std::vector<PreintegratedInterval> process(ImuStageInput in);
+
+  ImuStage stage;
+  LatestValue<NavState>& latest;
+};
+
+/// Estimator: pairs frames with their IMU intervals, runs the window BA, publishes the newest state.
+struct EstimatorStage {
+  std::vector<estimator::WindowEstimate> process(estimator::EstimatorInput in);
+  void finish() { pairer.finish(); }
+
+  FrameImuPairer pairer;
+  estimator::SlidingWindowEstimator estimator;
+  LatestValue<NavState>& latest;
+  LatestValue<Eigen::Vector3d>& gyro_bias;  ///< the same state's gyro bias, for the tracker
+  int64_t tracking = 0, resets = 0;
+};
+
+/// Writer: hands each estimate to the run's sink.
+struct WriterStage {
+  void process(estimator::WindowEstimate e) {
+    if (sink) sink(e);
+  }
+  std::function<void(const estimator::WindowEstimate&)> sink;
+};
+
+/// Every stage of one run and the feedback snapshots between them, built from the run's options.
+/// Not copyable or movable: the stages hold references to the snapshots.
+struct VioStages {
+  VioStages(const VioRunOptions& options, std::function<void(const TrackedFrame&)> on_tracked,
+            std::function<void(const estimator::WindowEstimate&)> on_estimate);
+  VioStages(const VioStages&) = delete;
+  VioStages& operator=(const VioStages&) = delete;
+
+  /// The stages' counters, into `result` (after the last input).
+  void collect(VioRunResult& result) const;
+
+  bool predict = false;            ///< gyro-predicted KLT on (asked for, and the extrinsic is known)
+  bool solver_time_budget = true;  ///< the config's max_solver_time applies (paced runs only)
+  LatestValue<NavState> latest;
+  LatestValue<Eigen::Vector3d> gyro_bias;
+  TrackerStage tracker;
+  ImuFeedbackStage imu;
+  EstimatorStage estimator;
+  WriterStage writer;
+};
+
+}  // namespace dynavins::pipeline
