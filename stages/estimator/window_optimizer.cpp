@@ -176,116 +176,199 @@ double WindowOptimizer::featureResidual(const WindowState& s, const WindowFeatur
   return featureResidualWith(f, opt_, [&s](int k, int c) { return s.camera(k, c); }, g);
 }
 
-SolveStats WindowOptimizer::solve(WindowState& s, int newest, WindowFeatures& features) {
-  SolveStats st;
-  const auto t_ba = Clock::now();
-  const WindowGauge gauge = WindowGauge::of(s);
+namespace {
 
-  ceres::Problem::Options po;
-  po.cost_function_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
-  po.loss_function_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
-  po.manifold_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
-  // The blocks and residuals below are well-formed by construction; skip Ceres' per-call validation
-  // (it only checks arguments, the problem and its solution are the same).
-  po.disable_all_safety_checks = true;
-  ceres::Problem problem(po);
-  PoseManifold pose_manifold;
-  std::vector<std::shared_ptr<ceres::CostFunction>> costs;  // alive until the problem goes
+/// The window's nonlinear least squares as one Ceres problem (paper eq. 1 for huber; for dynavins eq. 11
+/// with the weights w_j held fixed, which the reprojection factors read through pointers): the states of
+/// slots 0..newest, the fixed extrinsics, then the residuals in this order: the marginalisation prior,
+/// the IMU factors, the zero-velocity factors, every visual residual of the features in the BA.
+class WindowProblem {
+ public:
+  WindowProblem(WindowState& s, int newest, WindowFeatures& features, const WindowSolveOptions& opt,
+                const std::shared_ptr<MarginalizationInfo>& prior, const std::vector<double*>& prior_blocks)
+      : problem_(problemOptions()) {
+    addStates(s, newest, opt);
+    if (prior) addCost(std::make_shared<MarginalizationFactor>(prior), nullptr, prior_blocks);
+    addImu(s, newest, opt);
+    addZeroVelocity(s, newest, opt);
+    addVisual(s, newest, features, opt);
+  }
+  WindowProblem(const WindowProblem&) = delete;
+  WindowProblem& operator=(const WindowProblem&) = delete;
 
-  for (int k = 0; k <= newest; ++k) {
-    problem.AddParameterBlock(s.pose[k].data(), kPoseSize, &pose_manifold);
-    problem.AddParameterBlock(s.speed_bias[k].data(), kSpeedBiasSize);
+  ceres::Problem& problem() { return problem_; }
+  /// The features whose residuals are in the problem (the ones the weight step of eq. 10 solves for).
+  const std::vector<WindowFeature*>& features() const { return in_ba_; }
+
+ private:
+  static ceres::Problem::Options problemOptions() {
+    ceres::Problem::Options po;
+    po.cost_function_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
+    po.loss_function_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
+    po.manifold_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
+    // The blocks and residuals below are well-formed by construction; skip Ceres' per-call validation
+    // (it only checks arguments, the problem and its solution are the same).
+    po.disable_all_safety_checks = true;
+    return po;
   }
-  for (int c = 0; c < (opt_.stereo ? 2 : 1); ++c) {
-    problem.AddParameterBlock(s.extrinsic[c].data(), kPoseSize, &pose_manifold);
-    problem.SetParameterBlockConstant(s.extrinsic[c].data());  // fixed from config
+
+  void addCost(std::shared_ptr<ceres::CostFunction> cost, ceres::LossFunction* loss,
+               const std::vector<double*>& blocks) {
+    problem_.AddResidualBlock(cost.get(), loss, blocks);
+    costs_.push_back(std::move(cost));
   }
-  if (prior_) {
-    auto cost = std::make_shared<MarginalizationFactor>(prior_);
-    costs.push_back(cost);
-    problem.AddResidualBlock(cost.get(), nullptr, prior_blocks_);
-  }
-  for (int k = 1; k <= newest; ++k) {
-    if (!imuUsable(s, k)) continue;
-    auto cost = std::make_shared<ImuFactor>(s.preint[k].get(), opt_.gravity);
-    costs.push_back(cost);
-    problem.AddResidualBlock(cost.get(), nullptr, s.pose[k - 1].data(), s.speed_bias[k - 1].data(),
-                             s.pose[k].data(), s.speed_bias[k].data());
-  }
-  for (int k = 0; k <= newest; ++k) {
-    if (!s.still[k]) continue;
-    auto cost = std::make_shared<ZeroVelocityFactor>(opt_.zero_velocity_sigma);
-    costs.push_back(cost);
-    problem.AddResidualBlock(cost.get(), nullptr, s.speed_bias[k].data());
-  }
-  std::vector<WindowFeature*> in_ba;
-  for (auto& [id, f] : features.all()) {
-    if (!f.inBa() || f.start_slot > newest) continue;
-    in_ba.push_back(&f);
-    for (VisualResidual& r : visualResiduals(s, f, opt_)) {
-      auto loss = lossFor(r, opt_);
-      costs.push_back(r.cost);
-      problem.AddResidualBlock(r.cost.get(), loss.get(), r.blocks);
+
+  /// Pose and speed-bias of every slot; the camera extrinsics, fixed from config.
+  void addStates(WindowState& s, int newest, const WindowSolveOptions& opt) {
+    for (int k = 0; k <= newest; ++k) {
+      problem_.AddParameterBlock(s.pose[k].data(), kPoseSize, &pose_manifold_);
+      problem_.AddParameterBlock(s.speed_bias[k].data(), kSpeedBiasSize);
+    }
+    for (int c = 0; c < (opt.stereo ? 2 : 1); ++c) {
+      problem_.AddParameterBlock(s.extrinsic[c].data(), kPoseSize, &pose_manifold_);
+      problem_.SetParameterBlockConstant(s.extrinsic[c].data());
     }
   }
-  st.features_in_window = static_cast<int>(in_ba.size());
 
-  ceres::Solver::Options so;
-  so.linear_solver_type = ceres::DENSE_SCHUR;
-  so.trust_region_strategy_type = ceres::DOGLEG;
-  so.num_threads = 1;  // stage libraries start no threads (pipeline/ does)
-  so.logging_type = ceres::SILENT;
+  /// Preintegrated IMU between consecutive slots (the inertial term of eq. 1).
+  void addImu(WindowState& s, int newest, const WindowSolveOptions& opt) {
+    for (int k = 1; k <= newest; ++k) {
+      if (!imuUsable(s, k)) continue;
+      addCost(std::make_shared<ImuFactor>(s.preint[k].get(), opt.gravity), nullptr,
+              {s.pose[k - 1].data(), s.speed_bias[k - 1].data(), s.pose[k].data(), s.speed_bias[k].data()});
+    }
+  }
 
-  const bool dyn = opt_.loss == BaLoss::Dynavins;
-  int budget = opt_.max_iterations;
-  double time_left = opt_.max_solver_time_s;
-  auto runSolver = [&](int iterations) {
-    so.max_num_iterations = std::max(1, iterations);
-    so.max_solver_time_in_seconds = std::max(1e-3, time_left);
+  /// Zero velocity on the slots found at rest (standstill_detector.hpp; not in the paper).
+  void addZeroVelocity(WindowState& s, int newest, const WindowSolveOptions& opt) {
+    for (int k = 0; k <= newest; ++k) {
+      if (!s.still[k]) continue;
+      addCost(std::make_shared<ZeroVelocityFactor>(opt.zero_velocity_sigma), nullptr, {s.speed_bias[k].data()});
+    }
+  }
+
+  /// Reprojection residuals (the visual term of eq. 1; weighted by w_j in eq. 11, see lossFor for the loss).
+  void addVisual(WindowState& s, int newest, WindowFeatures& features, const WindowSolveOptions& opt) {
+    for (auto& [id, f] : features.all()) {
+      if (!f.inBa() || f.start_slot > newest) continue;
+      in_ba_.push_back(&f);
+      for (VisualResidual& r : visualResiduals(s, f, opt)) addCost(r.cost, lossFor(r, opt).get(), r.blocks);
+    }
+  }
+
+  // Declared before the problem, which points into them: they outlive it.
+  PoseManifold pose_manifold_;
+  std::vector<std::shared_ptr<ceres::CostFunction>> costs_;
+  ceres::Problem problem_;
+  std::vector<WindowFeature*> in_ba_;
+};
+
+/// The Ceres state solves of one window solve and their shared budget: `max_iterations` over all of them
+/// together (so a robust BA costs about what a Huber BA does) and `max_solver_time_s` (may be infinite).
+class StateSolver {
+ public:
+  StateSolver(ceres::Problem& problem, const WindowSolveOptions& opt, SolveStats& st)
+      : problem_(problem), st_(st), budget_(opt.max_iterations), time_left_(opt.max_solver_time_s) {
+    so_.linear_solver_type = ceres::DENSE_SCHUR;
+    so_.trust_region_strategy_type = ceres::DOGLEG;
+    so_.num_threads = 1;  // stage libraries start no threads (pipeline/ does)
+    so_.logging_type = ceres::SILENT;
+  }
+
+  /// Solves the states with everything else fixed for up to `iterations` (at least 1) and whatever time
+  /// is left; returns whether Ceres converged.
+  bool run(int iterations) {
+    so_.max_num_iterations = std::max(1, iterations);
+    so_.max_solver_time_in_seconds = std::max(1e-3, time_left_);
     ceres::Solver::Summary summary;
-    ceres::Solve(so, &problem, &summary);
+    ceres::Solve(so_, &problem_, &summary);
     const int used = summary.num_successful_steps + summary.num_unsuccessful_steps;
-    st.ceres_iterations += used;
-    budget -= std::max(1, used);
-    time_left -= summary.total_time_in_seconds;
-    ++st.alternations;
+    st_.ceres_iterations += used;
+    budget_ -= std::max(1, used);
+    time_left_ -= summary.total_time_in_seconds;
+    ++st_.alternations;
     return summary.termination_type == ceres::CONVERGENCE;
-  };
-  // Weight step (eq. 10 in closed form); returns the share of weights that moved less than the tolerance.
-  std::vector<std::array<CameraPose, 2>> cameras(newest + 1);
-  FeatureGeometry geometry;
-  auto weightStep = [&]() {
+  }
+  int iterationsLeft() const { return budget_; }
+  bool exhausted() const { return budget_ <= 0 || !(time_left_ > 0); }
+
+ private:
+  ceres::Problem& problem_;
+  SolveStats& st_;
+  ceres::Solver::Options so_;
+  int budget_;
+  double time_left_;
+};
+
+/// The weight step (paper eq. 10 in closed form, solveFeatureWeight) with the states fixed.
+class WeightStep {
+ public:
+  WeightStep(const WindowState& s, int newest, const WindowSolveOptions& opt, SolveStats& st)
+      : s_(s), newest_(newest), opt_(opt), st_(st), cameras_(newest + 1) {}
+
+  /// Updates every feature's w_j from its residual r_j at the current states; returns the share of
+  /// weights that moved less than settle_tolerance.
+  double operator()(const std::vector<WindowFeature*>& features) {
     const auto t0 = Clock::now();
     // The states are fixed during the weight step: each slot's camera poses once, not per observation.
-    for (int k = 0; k <= newest; ++k) cameras[k] = {s.camera(k, 0), s.camera(k, 1)};
-    auto camera = [&cameras](int k, int c) -> const CameraPose& { return cameras[k][c]; };
+    for (int k = 0; k <= newest_; ++k) cameras_[k] = {s_.camera(k, 0), s_.camera(k, 1)};
+    auto camera = [this](int k, int c) -> const CameraPose& { return cameras_[k][c]; };
     int settled = 0;
-    for (WindowFeature* f : in_ba) {
-      const double r = featureResidualWith(*f, opt_, camera, geometry);
+    for (WindowFeature* f : features) {
+      const double r = featureResidualWith(*f, opt_, camera, geometry_);
       const double w = solveFeatureWeight(r, f->weight_prev, f->times_solved, opt_.weights);
       if (std::abs(w - f->weight) < opt_.settle_tolerance) ++settled;
       f->weight = w;
     }
-    st.weight_ms += msSince(t0);
-    return in_ba.empty() ? 1.0 : static_cast<double>(settled) / in_ba.size();
-  };
+    st_.weight_ms += msSince(t0);
+    return features.empty() ? 1.0 : static_cast<double>(settled) / features.size();
+  }
 
-  if (!dyn) {
-    runSolver(budget);
+ private:
+  const WindowState& s_;
+  int newest_;
+  const WindowSolveOptions& opt_;
+  SolveStats& st_;
+  std::vector<std::array<CameraPose, 2>> cameras_;
+  FeatureGeometry geometry_;
+};
+
+/// Alternating optimisation of eq. (11) (paper III-C): the weights w_j by eq. (10) with the states fixed,
+/// then the states with the weights fixed, until the share of settled weights reaches
+/// `alternating_converge` with Ceres converged, `max_alternations` is reached or the budget is spent.
+/// Afterwards w̄_j = w_j and n_j grows by one (the momentum of eq. 9 for the next solve).
+void alternate(const WindowState& s, int newest, const std::vector<WindowFeature*>& features,
+               const WindowSolveOptions& opt, StateSolver& solver, SolveStats& st) {
+  WeightStep weight_step(s, newest, opt, st);
+  // Start from the previous weights (momentum's w̄) so "settled" compares against where we were.
+  for (WindowFeature* f : features) f->weight = f->weight_prev;
+  weight_step(features);
+  for (int a = 0; a < opt.max_alternations && !solver.exhausted(); ++a) {
+    const bool last = a + 1 == opt.max_alternations;
+    const int budget = solver.iterationsLeft();
+    const bool converged = solver.run(last ? budget : std::max(2, budget / 2));
+    const double settled = weight_step(features);
+    if (settled >= opt.alternating_converge && converged) break;
+  }
+  for (WindowFeature* f : features) {
+    f->weight_prev = f->weight;
+    ++f->times_solved;
+  }
+}
+
+}  // namespace
+
+SolveStats WindowOptimizer::solve(WindowState& s, int newest, WindowFeatures& features) {
+  SolveStats st;
+  const auto t_ba = Clock::now();
+  const WindowGauge gauge = WindowGauge::of(s);
+  WindowProblem window(s, newest, features, opt_, prior_, prior_blocks_);
+  st.features_in_window = static_cast<int>(window.features().size());
+  StateSolver solver(window.problem(), opt_, st);
+  if (opt_.loss == BaLoss::Dynavins) {
+    alternate(s, newest, window.features(), opt_, solver, st);
   } else {
-    // Start from the previous weights (momentum's w̄) so "settled" compares against where we were.
-    for (WindowFeature* f : in_ba) f->weight = f->weight_prev;
-    weightStep();
-    for (int a = 0; a < opt_.max_alternations && budget > 0 && time_left > 0; ++a) {
-      const bool last = a + 1 == opt_.max_alternations;
-      const bool converged = runSolver(last ? budget : std::max(2, budget / 2));
-      const double settled = weightStep();
-      if (settled >= opt_.alternating_converge && converged) break;
-    }
-    for (WindowFeature* f : in_ba) {
-      f->weight_prev = f->weight;
-      ++f->times_solved;
-    }
+    solver.run(solver.iterationsLeft());  // eq. 1, Huber loss on the visual residuals
   }
   gauge.restore(s, newest);
   st.ba_ms = msSince(t_ba);

@@ -53,6 +53,8 @@ class WindowOptimizer {
 
   void reset();
   bool hasPrior() const { return prior_ != nullptr; }
+  /// The marginalisation prior the next solve uses (null when there is none); read-only (tests).
+  const MarginalizationInfo* prior() const { return prior_.get(); }
   const WindowSolveOptions& options() const { return opt_; }
 
   /// Mean whitened squared reprojection residual of a feature over its weighted observations (the r_j

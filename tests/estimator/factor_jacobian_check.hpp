@@ -1,11 +1,12 @@
 #pragma once
-// Test helper for the estimator's cost functions: analytic Jacobians vs central differences taken in the
-// tangent space of each block (PoseManifold::Plus for pose blocks, additive for the others), and the
-// weight / null-Jacobian conventions of parameter_layout.hpp.
+// Test helper for the estimator's cost functions: central differences taken in the tangent space of each
+// block (PoseManifold::Plus for pose blocks, additive for the others), analytic Jacobians checked against
+// them, and the weight / null-Jacobian conventions of parameter_layout.hpp.
 #include "tests/estimator/catch_with_ceres.hpp"  // first: Catch's CHECK, not glog's
 
 #include <algorithm>
 #include <cmath>
+#include <functional>
 #include <string>
 #include <vector>
 
@@ -25,7 +26,14 @@ struct Evaluation {
   std::vector<RowMajorMatrix> jacobians;
 };
 
-inline Evaluation evaluate(const ceres::CostFunction& f, const std::vector<std::vector<double>>& params,
+/// Values of a cost's parameter blocks, one vector per block.
+using BlockValues = std::vector<std::vector<double>>;
+/// A residual as a function of its parameter blocks' values.
+using ResidualFunction = std::function<Eigen::VectorXd(const BlockValues&)>;
+
+/// Evaluates `f` at `params`. Every Jacobian starts filled with 99 (Ceres does not clear them either), so
+/// a factor must write each entry itself, column 7 of a pose block included.
+inline Evaluation evaluate(const ceres::CostFunction& f, const BlockValues& params,
                            const std::vector<bool>& want_jacobian = {}) {
   const int m = f.num_residuals();
   Evaluation e;
@@ -34,12 +42,39 @@ inline Evaluation evaluate(const ceres::CostFunction& f, const std::vector<std::
   std::vector<double*> jac_ptrs;
   for (size_t b = 0; b < params.size(); ++b) {
     ptrs.push_back(params[b].data());
-    e.jacobians.emplace_back(RowMajorMatrix::Zero(m, static_cast<int>(params[b].size())));
+    e.jacobians.emplace_back(RowMajorMatrix::Constant(m, static_cast<int>(params[b].size()), 99.0));
     const bool want = want_jacobian.empty() || want_jacobian[b];
     jac_ptrs.push_back(want ? e.jacobians.back().data() : nullptr);
   }
   REQUIRE(f.Evaluate(ptrs.data(), e.residual.data(), jac_ptrs.data()));
   return e;
+}
+
+/// Central differences of `residual` at `params` along the tangent space of block `b`: a pose block is
+/// perturbed through PoseManifold::Plus (6 columns), any other additively (one column per entry).
+inline RowMajorMatrix numericTangentJacobian(const ResidualFunction& residual, const BlockValues& params, size_t b,
+                                             Block kind, double step = 1e-6) {
+  const bool pose = kind == Block::Pose;
+  const int dim = pose ? 6 : static_cast<int>(params[b].size());
+  const PoseManifold manifold;
+  RowMajorMatrix numeric;
+  for (int k = 0; k < dim; ++k) {
+    BlockValues plus = params, minus = params;
+    if (pose) {
+      double delta[6] = {0, 0, 0, 0, 0, 0};
+      delta[k] = step;
+      manifold.Plus(params[b].data(), delta, plus[b].data());
+      delta[k] = -step;
+      manifold.Plus(params[b].data(), delta, minus[b].data());
+    } else {
+      plus[b][k] += step;
+      minus[b][k] -= step;
+    }
+    const Eigen::VectorXd column = (residual(plus) - residual(minus)) / (2.0 * step);
+    if (k == 0) numeric.resize(column.size(), dim);
+    numeric.col(k) = column;
+  }
+  return numeric;
 }
 
 /// Checks, per block, max |analytic - numeric| <= tol * max(1, max |numeric|), both Jacobians first multiplied
@@ -53,27 +88,13 @@ inline void requireJacobiansMatchNumeric(const ceres::CostFunction& f,
                                          double tol = 1e-6) {
   REQUIRE(params.size() == kinds.size());
   const Evaluation analytic = evaluate(f, params);
-  const PoseManifold manifold;
+  const ResidualFunction residual = [&f](const BlockValues& x) {
+    return Eigen::VectorXd(evaluate(f, x, std::vector<bool>(x.size(), false)).residual);
+  };
   for (size_t b = 0; b < params.size(); ++b) {
     const bool pose = kinds[b] == Block::Pose;
     const int dim = pose ? 6 : static_cast<int>(params[b].size());
-    RowMajorMatrix numeric(f.num_residuals(), dim);
-    for (int k = 0; k < dim; ++k) {
-      std::vector<std::vector<double>> plus = params, minus = params;
-      if (pose) {
-        double delta[6] = {0, 0, 0, 0, 0, 0};
-        delta[k] = step;
-        manifold.Plus(params[b].data(), delta, plus[b].data());
-        delta[k] = -step;
-        manifold.Plus(params[b].data(), delta, minus[b].data());
-      } else {
-        plus[b][k] += step;
-        minus[b][k] -= step;
-      }
-      numeric.col(k) = (evaluate(f, plus, std::vector<bool>(params.size(), false)).residual -
-                        evaluate(f, minus, std::vector<bool>(params.size(), false)).residual) /
-                       (2.0 * step);
-    }
+    RowMajorMatrix numeric = numericTangentJacobian(residual, params, b, kinds[b], step);
     RowMajorMatrix a = analytic.jacobians[b].leftCols(dim);
     if (row_transform.size() > 0) {
       a = row_transform * a;

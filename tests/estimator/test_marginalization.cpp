@@ -17,6 +17,7 @@
 #include "stages/estimator/marginalization/marginalization_factor.hpp"
 #include "stages/estimator/marginalization/marginalization_info.hpp"
 #include "stages/estimator/pose_manifold.hpp"
+#include "tests/estimator/factor_jacobian_check.hpp"
 
 using namespace dynavins;
 using namespace dynavins::estimator;
@@ -59,42 +60,9 @@ class LinearFactor final : public ceres::CostFunction {
 
 using ResidualFn = std::function<Eigen::VectorXd(const std::vector<const double*>&)>;
 
-/// Tangent Jacobian by central differences: size-7 blocks perturbed through PoseManifold::Plus and
-/// written in the first 6 columns (column 7 zero), others additively — the estimator's convention.
-void tangentNumericJacobians(const ResidualFn& f, const std::vector<int>& sizes, double const* const* x,
-                             int rows, double** jac) {
-  const PoseManifold pose;
-  const double h = 1e-6;
-  std::vector<std::vector<double>> values(sizes.size());
-  std::vector<const double*> ptrs(sizes.size());
-  for (size_t i = 0; i < sizes.size(); ++i) {
-    values[i].assign(x[i], x[i] + sizes[i]);
-    ptrs[i] = values[i].data();
-  }
-  for (size_t i = 0; i < sizes.size(); ++i) {
-    if (!jac[i]) continue;
-    Eigen::Map<RowMajor> ji(jac[i], rows, sizes[i]);
-    ji.setZero();
-    const int tangent = MarginalizationInfo::tangentSize(sizes[i]);
-    for (int k = 0; k < tangent; ++k) {
-      Eigen::VectorXd r_pm[2];
-      for (int s = 0; s < 2; ++s) {
-        Eigen::VectorXd delta = Eigen::VectorXd::Zero(tangent);
-        delta(k) = s == 0 ? h : -h;
-        if (sizes[i] == 7) {
-          pose.Plus(x[i], delta.data(), values[i].data());
-        } else {
-          for (int d = 0; d < sizes[i]; ++d) values[i][d] = x[i][d] + delta(d);
-        }
-        r_pm[s] = f(ptrs);
-      }
-      values[i].assign(x[i], x[i] + sizes[i]);
-      ji.col(k) = (r_pm[0] - r_pm[1]) / (2.0 * h);
-    }
-  }
-}
-
-/// A cost from a residual function with numeric tangent Jacobians.
+/// A cost from a residual function with numeric tangent Jacobians (factor_jacobian_check.hpp's central
+/// differences): size-7 blocks perturbed through PoseManifold::Plus and written in the first 6 columns
+/// (column 7 zero), others additively — the estimator's convention.
 class NumericTangentCost final : public ceres::CostFunction {
  public:
   NumericTangentCost(ResidualFn f, std::vector<int> sizes, int rows) : f_(std::move(f)) {
@@ -102,10 +70,25 @@ class NumericTangentCost final : public ceres::CostFunction {
     set_num_residuals(rows);
   }
   bool Evaluate(double const* const* x, double* r, double** jac) const override {
-    const std::vector<int> sizes(parameter_block_sizes().begin(), parameter_block_sizes().end());
+    const std::vector<int32_t>& sizes = parameter_block_sizes();
     std::vector<const double*> ptrs(x, x + sizes.size());
     Eigen::Map<Eigen::VectorXd>(r, num_residuals()) = f_(ptrs);
-    if (jac) tangentNumericJacobians(f_, sizes, x, num_residuals(), jac);
+    if (!jac) return true;
+    test::BlockValues values;
+    for (size_t i = 0; i < sizes.size(); ++i) values.emplace_back(x[i], x[i] + sizes[i]);
+    const test::ResidualFunction residual = [this](const test::BlockValues& v) {
+      std::vector<const double*> p;
+      for (const auto& block : v) p.push_back(block.data());
+      return f_(p);
+    };
+    for (size_t i = 0; i < sizes.size(); ++i) {
+      if (!jac[i]) continue;
+      const test::Block kind = sizes[i] == 7 ? test::Block::Pose : test::Block::Euclidean;
+      Eigen::Map<RowMajor> ji(jac[i], num_residuals(), sizes[i]);
+      ji.setZero();
+      const RowMajor numeric = test::numericTangentJacobian(residual, values, i, kind);
+      ji.leftCols(numeric.cols()) = numeric;
+    }
     return true;
   }
 
@@ -421,31 +404,11 @@ TEST_CASE("MarginalizationFactor Jacobians match numeric differentiation through
   manifold.Plus(t2.data(), d2.data(), t2m.data());
   std::array<double, 9> sbm = sb;
   for (double& v : sbm) v += 0.3;
-  const double* params[] = {t1m.data(), sbm.data(), t2m.data()};
-  const std::vector<int> sizes{7, 9, 7};
-  std::vector<RowMajor> analytic, numeric;
-  std::vector<double*> ja, jn;
-  for (int s : sizes) {
-    analytic.emplace_back(RowMajor::Constant(rows, s, 99.0));
-    numeric.emplace_back(RowMajor::Zero(rows, s));
-    ja.push_back(analytic.back().data());
-    jn.push_back(numeric.back().data());
-  }
-  Eigen::VectorXd r(rows);
-  REQUIRE(prior.Evaluate(params, r.data(), ja.data()));
-  const ResidualFn f = [&prior, rows](const std::vector<const double*>& x) {
-    Eigen::VectorXd out(rows);
-    prior.Evaluate(x.data(), out.data(), nullptr);
-    return out;
-  };
-  tangentNumericJacobians(f, sizes, params, rows, jn.data());
-  for (size_t i = 0; i < sizes.size(); ++i) {
-    INFO("block " << i);
-    CHECK((analytic[i] - numeric[i]).cwiseAbs().maxCoeff() < 1e-6);
-    if (sizes[i] == 7) CHECK(analytic[i].col(6).isZero(0.0));
-  }
+  const test::BlockValues params{{t1m.begin(), t1m.end()}, {sbm.begin(), sbm.end()}, {t2m.begin(), t2m.end()}};
+  test::requireJacobiansMatchNumeric(prior, params, {test::Block::Pose, test::Block::Euclidean, test::Block::Pose});
+  const RowMajor analytic0 = test::evaluate(prior, params).jacobians[0];
   // The identity approximation of d Log / dθ would be off by far more than the tolerance here.
-  CHECK((analytic[0].middleCols<3>(3) - info->linearizedJacobian().middleCols<3>(3)).cwiseAbs().maxCoeff() > 1e-3);
+  CHECK((analytic0.middleCols<3>(3) - info->linearizedJacobian().middleCols<3>(3)).cwiseAbs().maxCoeff() > 1e-3);
 }
 
 TEST_CASE("Dropping a block that shares no factor with the kept ones leaves the prior unchanged",

@@ -146,11 +146,30 @@ void MarginalizationInfo::linearize() {
   linearized_ = true;
 }
 
-bool MarginalizationInfo::assemble(const std::vector<char>& scalar, Eigen::MatrixXd& H, Eigen::VectorXd& b,
-                                   int& dropped_dense_size) const {
+/// A scalar dropped block d couples (through its residuals) with a few dense blocks only, and with no
+/// other scalar block, so its row of H is h_dd, the coupling c_d = H_{dense,d} over those blocks, b_d.
+struct MarginalizationInfo::ScalarBlock {
+  double h = 0.0, b = 0.0;
+  std::vector<int> neighbours;  ///< dense block indices
+  std::vector<int> local;       ///< offset of each neighbour in c
+  Eigen::VectorXd c;
+};
+
+namespace {
+/// Copies the upper triangle of a square matrix into its lower one.
+void mirrorUpperTriangle(Eigen::MatrixXd& H) {
+  const int total = static_cast<int>(H.rows());
+  for (int j = 0; j < total; ++j) {
+    for (int i = j + 1; i < total; ++i) H(i, j) = H(j, i);
+  }
+}
+}  // namespace
+
+int MarginalizationInfo::denseColumnOffsets(const std::vector<char>& scalar, std::vector<int>& offset,
+                                            int& dropped_dense_size) const {
   const int num_blocks = static_cast<int>(blocks_.size());
-  // Dense column layout: non-scalar dropped blocks first (in order of appearance), then the kept ones.
-  std::vector<int> offset(num_blocks, -1);
+  // Non-scalar dropped blocks first (in order of appearance), then the kept ones; scalar ones get -1.
+  offset.assign(num_blocks, -1);
   int total = 0;
   for (int i = 0; i < num_blocks; ++i) {
     if (is_dropped_[i] && !scalar[i]) {
@@ -165,37 +184,34 @@ bool MarginalizationInfo::assemble(const std::vector<char>& scalar, Eigen::Matri
       total += tangentSize(sizes_[i]);
     }
   }
+  return total;
+}
 
-  // A scalar dropped block d couples (through its residuals) with a few dense blocks only, and with no
-  // other scalar block, so its row of H is h_dd, the coupling c_d = H_{dense,d} over those blocks, b_d.
-  struct Scalar {
-    double h = 0.0, b = 0.0;
-    std::vector<int> neighbours;  ///< dense block indices
-    std::vector<int> local;       ///< offset of each neighbour in c
-    Eigen::VectorXd c;
-  };
-  std::vector<int> scalar_id(num_blocks, -1);
-  std::vector<Scalar> scalars;
+std::vector<MarginalizationInfo::ScalarBlock> MarginalizationInfo::scalarBlocks(
+    const std::vector<char>& scalar, std::vector<int>& scalar_id, std::vector<int>& residual_scalar) const {
+  const int num_blocks = static_cast<int>(blocks_.size());
+  scalar_id.assign(num_blocks, -1);
+  std::vector<ScalarBlock> scalars;
   for (int i = 0; i < num_blocks; ++i) {
     if (scalar[i]) {
       scalar_id[i] = static_cast<int>(scalars.size());
       scalars.emplace_back();
     }
   }
-  std::vector<int> residual_scalar(residuals_.size(), -1);  // index into the residual's blocks, or -1
+  residual_scalar.assign(residuals_.size(), -1);
   for (size_t k = 0; k < residuals_.size(); ++k) {
     const std::vector<int>& blocks = residual_blocks_[k];
     for (size_t i = 0; i < blocks.size(); ++i) {
       if (scalar_id[blocks[i]] >= 0) residual_scalar[k] = static_cast<int>(i);
     }
     if (residual_scalar[k] < 0) continue;
-    Scalar& s = scalars[scalar_id[blocks[residual_scalar[k]]]];
+    ScalarBlock& s = scalars[scalar_id[blocks[residual_scalar[k]]]];
     for (int blk : blocks) {
       if (scalar_id[blk] >= 0) continue;
       if (std::find(s.neighbours.begin(), s.neighbours.end(), blk) == s.neighbours.end()) s.neighbours.push_back(blk);
     }
   }
-  for (Scalar& s : scalars) {
+  for (ScalarBlock& s : scalars) {
     int n = 0;
     s.local.resize(s.neighbours.size());
     for (size_t j = 0; j < s.neighbours.size(); ++j) {
@@ -204,11 +220,13 @@ bool MarginalizationInfo::assemble(const std::vector<char>& scalar, Eigen::Matri
     }
     s.c = Eigen::VectorXd::Zero(n);
   }
+  return scalars;
+}
 
-  // Gauss-Newton system H = Σ J^T J, b = Σ J^T r over all residual blocks; the dense part in its upper
-  // triangle (blocks above the diagonal, diagonal blocks whole), mirrored below afterwards.
-  H.setZero(total, total);
-  b.setZero(total);
+void MarginalizationInfo::accumulateNormalEquations(const std::vector<int>& offset, const std::vector<int>& scalar_id,
+                                                    const std::vector<int>& residual_scalar,
+                                                    std::vector<ScalarBlock>& scalars, Eigen::MatrixXd& H,
+                                                    Eigen::VectorXd& b) const {
   std::vector<int> col;  // per block of the residual: column in its Jacobian buffer
   for (size_t k = 0; k < residuals_.size(); ++k) {
     const std::vector<int>& blocks = residual_blocks_[k];
@@ -239,7 +257,7 @@ bool MarginalizationInfo::assemble(const std::vector<char>& scalar, Eigen::Matri
       }
     }
     if (si >= 0) {
-      Scalar& s = scalars[scalar_id[blocks[si]]];
+      ScalarBlock& s = scalars[scalar_id[blocks[si]]];
       const auto jd = J(si);  // rows x 1
       s.h += jd.squaredNorm();
       s.b += jd.col(0).dot(r);
@@ -251,9 +269,12 @@ bool MarginalizationInfo::assemble(const std::vector<char>& scalar, Eigen::Matri
       }
     }
   }
+}
 
-  // Eliminate the scalar blocks: H -= c c^T / h_dd, b -= c b_d / h_dd (H_dd is diagonal over them).
-  for (const Scalar& s : scalars) {
+bool MarginalizationInfo::eliminateScalarBlocks(const std::vector<ScalarBlock>& scalars, const std::vector<int>& offset,
+                                                Eigen::MatrixXd& H, Eigen::VectorXd& b) const {
+  // H -= c c^T / h_dd, b -= c b_d / h_dd (H_dd is diagonal over the scalar blocks).
+  for (const ScalarBlock& s : scalars) {
     if (!(s.h > eigenvalue_threshold_)) return false;
     const double inv_h = 1.0 / s.h;
     const Eigen::VectorXd c_scaled = s.c * inv_h;
@@ -270,9 +291,23 @@ bool MarginalizationInfo::assemble(const std::vector<char>& scalar, Eigen::Matri
       }
     }
   }
-  for (int j = 0; j < total; ++j) {
-    for (int i = j + 1; i < total; ++i) H(i, j) = H(j, i);
-  }
+  return true;
+}
+
+bool MarginalizationInfo::assemble(const std::vector<char>& scalar, Eigen::MatrixXd& H, Eigen::VectorXd& b,
+                                   int& dropped_dense_size) const {
+  std::vector<int> offset;
+  const int total = denseColumnOffsets(scalar, offset, dropped_dense_size);
+  std::vector<int> scalar_id, residual_scalar;
+  std::vector<ScalarBlock> scalars = scalarBlocks(scalar, scalar_id, residual_scalar);
+  // Gauss-Newton system H = Σ J^T J, b = Σ J^T r over all residual blocks; the dense part in its upper
+  // triangle (blocks above the diagonal, diagonal blocks whole), mirrored below once the scalar blocks
+  // are eliminated.
+  H.setZero(total, total);
+  b.setZero(total);
+  accumulateNormalEquations(offset, scalar_id, residual_scalar, scalars, H, b);
+  if (!eliminateScalarBlocks(scalars, offset, H, b)) return false;
+  mirrorUpperTriangle(H);
   return true;
 }
 

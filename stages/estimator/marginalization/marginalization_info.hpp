@@ -84,6 +84,24 @@ class MarginalizationInfo {
   /// a scalar block has no information (H_dd <= threshold): the caller then retries with none scalar.
   bool assemble(const std::vector<char>& scalar, Eigen::MatrixXd& H, Eigen::VectorXd& b,
                 int& dropped_dense_size) const;
+  /// A scalar dropped block's row of H (defined in the .cpp).
+  struct ScalarBlock;
+  /// assemble()'s phases. Column offset of every block in the dense system (-1 for the scalar ones);
+  /// returns the system's size, `dropped_dense_size` the size of its dropped part.
+  int denseColumnOffsets(const std::vector<char>& scalar, std::vector<int>& offset, int& dropped_dense_size) const;
+  /// One ScalarBlock (neighbours known, sums zero) per scalar block; `scalar_id` per block: its index there
+  /// or -1; `residual_scalar` per residual: the position of its scalar block among its blocks, or -1.
+  std::vector<ScalarBlock> scalarBlocks(const std::vector<char>& scalar, std::vector<int>& scalar_id,
+                                        std::vector<int>& residual_scalar) const;
+  /// Adds every residual's J^T J and J^T r: the dense blocks' into the upper triangle of H and into b,
+  /// the scalar blocks' into their ScalarBlock.
+  void accumulateNormalEquations(const std::vector<int>& offset, const std::vector<int>& scalar_id,
+                                 const std::vector<int>& residual_scalar, std::vector<ScalarBlock>& scalars,
+                                 Eigen::MatrixXd& H, Eigen::VectorXd& b) const;
+  /// Schur complement of the scalar blocks into the upper triangle of H and into b; false if one of them
+  /// has no information (h_dd at or below the threshold).
+  bool eliminateScalarBlocks(const std::vector<ScalarBlock>& scalars, const std::vector<int>& offset,
+                             Eigen::MatrixXd& H, Eigen::VectorXd& b) const;
 
   double eigenvalue_threshold_;
   std::vector<ResidualBlockInfo> residuals_;
