@@ -19,12 +19,12 @@ using O = EstimatorOptions;
 // gave a 2.7 m ATE, one of 10^8 frames 14 GB); they are not tuning advice.
 const std::vector<OptionSpec>& optionSpecs() {
   static const std::vector<OptionSpec> table{
-      {"estimate_extrinsic", &O::estimate_extrinsic, {0, 2}, "", "0 fixed, 1 refine around body_T_cam, 2 calibrate from scratch"},
+      {"estimate_extrinsic", &O::estimate_extrinsic, {0, 2}, "", "VINS-Fusion: 0 fixed, 1 refine, 2 calibrate; here the extrinsic stays fixed (2 allows no body_T_cam)"},
       // Feature tracker.
       {"max_cnt", &O::max_cnt, {10, 2000}, "", "features kept per frame"},
       {"min_dist", &O::min_dist, {0, 200}, "px", "minimum distance between features"},
-      {"freq", &O::freq, {0, 1000}, "Hz", "rate of published tracking; 0 = every image"},
-      {"F_threshold", &O::F_threshold, {0, 50, true}, "px", "fundamental-matrix RANSAC threshold"},
+      {"freq", &O::freq, {0, 1000}, "Hz", "VINS-Fusion's rate of published tracking (read, not used: every image is tracked)"},
+      {"F_threshold", &O::F_threshold, {0, 50, true}, "px", "fundamental-matrix RANSAC threshold (the RANSAC is off, as in VINS-Fusion)"},
       {"show_track", &O::show_track, {}, "", "VINS-Fusion's tracking image (read, not drawn here)"},
       {"flow_back", &O::flow_back, {}, "", "forward-backward check of the temporal KLT"},
       {"patch_refine", &O::patch_refine, {}, "", "align each track's first patch after the KLT (ours); 0 = plain KLT"},
@@ -45,8 +45,8 @@ const std::vector<OptionSpec>& optionSpecs() {
       {"acc_w", &O::acc_w, {0, 10, true}, "m/s^3/sqrt(Hz)", "accelerometer bias random walk", true},
       {"gyr_w", &O::gyr_w, {0, 10, true}, "rad/s^2/sqrt(Hz)", "gyroscope bias random walk", true},
       {"g_norm", &O::g_norm, {9.5, 10}, "m/s^2", "gravity magnitude", true},
-      {"estimate_td", &O::estimate_td, {}, "", "estimate the camera-IMU time offset online"},
-      {"td", &O::td, {-1, 1}, "s", "time offset: image clock + td = IMU clock"},
+      {"estimate_td", &O::estimate_td, {}, "", "estimate the camera-IMU time offset online (read, not used yet)"},
+      {"td", &O::td, {-1, 1}, "s", "time offset: image clock + td = IMU clock (read, not used yet)"},
       // DynaVINS (see estimator_options.hpp for the mapping).
       {"dyna_on", &O::dyna_on, {}, "", "per-feature weights (the authors' switch)"},
       {"regularization_lambda", &O::regularization_gamma, {0, 100}, "", "gamma of the authors' code; lambda_w = gamma^2"},
