@@ -457,7 +457,7 @@ TEST_CASE("An unknown yaml key is warned, naming it and the file, with the neare
   CHECK(text.find("my_own_setting' (ignored);") == std::string::npos);  // nothing close to it
 }
 
-TEST_CASE("--set with an unknown key names the nearest key and lists the valid ones", "[options][table]") {
+TEST_CASE("An unknown --set key names the nearest key and lists the valid ones", "[options][table]") {
   EstimatorOptions o = EstimatorOptions::load(kEuroc + "euroc_stereo_imu_config.yaml");
   CHECK_THROWS_WITH(o.apply("momentum_lamda", "1"),
                     Catch::Contains("did you mean momentum_lambda?") && Catch::Contains("max_cnt") &&
