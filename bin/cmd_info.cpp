@@ -1,5 +1,7 @@
 // `dynavins info`: what this build is: version, libraries, LCM wire types and channels.
+// `dynavins info --options-markdown`: the config keys as the README's Markdown table.
 #include <cstdio>
+#include <memory>
 
 #include <CLI/CLI.hpp>
 #include <Eigen/Core>
@@ -19,6 +21,7 @@
 
 #include "bin/commands.hpp"
 #include "pipeline/lcm_channels.hpp"
+#include "stages/common/estimator_options.hpp"
 
 namespace dynavins::cli {
 namespace {
@@ -52,7 +55,14 @@ void run_info() {
 
 void add_info_command(CLI::App& app) {
   auto* cmd = app.add_subcommand("info", "Show the version, libraries, LCM wire types and channels");
-  cmd->callback(run_info);
+  auto markdown = std::make_shared<bool>(false);
+  cmd->add_flag("--options-markdown", *markdown, "Print the config keys (yaml and --set) as a Markdown table");
+  cmd->callback([markdown] {
+    if (*markdown)
+      std::fputs(optionsMarkdownTable().c_str(), stdout);
+    else
+      run_info();
+  });
 }
 
 }  // namespace dynavins::cli

@@ -2,6 +2,7 @@
 
 #include <cmath>
 #include <filesystem>
+#include <set>
 
 #include <opencv2/core.hpp>
 
@@ -35,6 +36,15 @@ ConfigReader::ConfigReader(const std::string& path) : path_(path) {
     throw ConfigError(path, "", "not a valid OpenCV yaml file: " + e.msg);
   }
   if (!fs_.isOpened()) throw ConfigError(path, "", "cannot open as an OpenCV yaml file");
+  // OpenCV's map keeps every entry while fs_[key] finds the first, so a repeat is seen here.
+  const cv::FileNode root = fs_.root();
+  if (!root.isMap()) return;
+  std::set<std::string> seen;
+  for (auto it = root.begin(); it != root.end(); ++it) {
+    const std::string key = (*it).name();
+    if (!seen.insert(key).second) fail(key, "appears more than once in the file (remove one of them)");
+    keys_.push_back(key);
+  }
 }
 
 void ConfigReader::fail(const std::string& key, const std::string& problem) const {
@@ -62,7 +72,12 @@ std::optional<int> ConfigReader::find_int(const std::string& key) const {
 std::optional<double> ConfigReader::find_double(const std::string& key) const {
   if (!has(key)) return std::nullopt;
   const cv::FileNode n = node(key);
-  if (n.isInt() || n.isReal()) return static_cast<double>(n);
+  if (n.isInt()) return static_cast<double>(n);
+  if (n.isReal()) {
+    const double v = static_cast<double>(n);
+    if (!std::isfinite(v)) fail(key, "expected a finite number, found " + std::to_string(v));
+    return v;
+  }
   fail(key, "expected a number, found " + type_name(n));
 }
 
@@ -110,6 +125,7 @@ double ConfigReader::get_nested_double(const std::string& map, const std::string
   const cv::FileNode n = m[key];
   if (n.empty() || n.isNone()) fail(full, "required key is missing");
   if (!n.isInt() && !n.isReal()) fail(full, "expected a number, found " + type_name(n));
+  if (!std::isfinite(static_cast<double>(n))) fail(full, "expected a finite number");
   return static_cast<double>(n);
 }
 

@@ -2,9 +2,12 @@
 // Typed access to one OpenCV FileStorage yaml (the format VINS-Fusion and camodocs use), with the
 // quirks of real files tolerated: reals written for ints when integral, 0/1 or true/false flags,
 // OpenCV keeping a trailing "# comment" inside unquoted strings. Every failure is a ConfigError.
+// A top-level key written twice is an error (OpenCV would keep the first value silently), and so is a
+// non-finite number (.nan, .inf).
 
 #include <optional>
 #include <string>
+#include <vector>
 
 #include <Eigen/Geometry>
 #include <opencv2/core/persistence.hpp>
@@ -15,10 +18,13 @@ namespace dynavins {
 
 class ConfigReader {
  public:
-  /// Opens `path`; throws ConfigError naming the file if it is missing or not valid yaml.
+  /// Opens `path`; throws ConfigError naming the file if it is missing, not valid yaml, or repeats a
+  /// top-level key (naming the key).
   explicit ConfigReader(const std::string& path);
 
   const std::string& path() const { return path_; }
+  /// The file's top-level keys in file order.
+  const std::vector<std::string>& keys() const { return keys_; }
   bool has(const std::string& key) const;
 
   /// Required values: throw ConfigError naming key and file when absent or of the wrong type.
@@ -44,6 +50,7 @@ class ConfigReader {
   cv::FileNode node(const std::string& key) const;
   std::string path_;
   cv::FileStorage fs_;
+  std::vector<std::string> keys_;
 };
 
 }  // namespace dynavins

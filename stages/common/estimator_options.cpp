@@ -1,10 +1,10 @@
 #include "stages/common/estimator_options.hpp"
 
+#include <algorithm>
 #include <cmath>
-#include <functional>
 #include <iomanip>
-#include <map>
 #include <sstream>
+#include <type_traits>
 
 #include <spdlog/spdlog.h>
 
@@ -12,27 +12,214 @@
 #include "stages/common/config_reader.hpp"
 
 namespace dynavins {
+
+using O = EstimatorOptions;
+
+// The option table: one line per scalar key. Ranges reject what cannot be meant (a window of 1 frame
+// gave a 2.7 m ATE, one of 10^8 frames 14 GB); they are not tuning advice.
+const std::vector<OptionSpec>& optionSpecs() {
+  static const std::vector<OptionSpec> table{
+      {"estimate_extrinsic", &O::estimate_extrinsic, {0, 2}, "", "VINS-Fusion: 0 fixed, 1 refine, 2 calibrate; here the extrinsic stays fixed (2 allows no body_T_cam)"},
+      // Feature tracker.
+      {"max_cnt", &O::max_cnt, {10, 2000}, "", "features kept per frame"},
+      {"min_dist", &O::min_dist, {0, 200}, "px", "minimum distance between features"},
+      {"freq", &O::freq, {0, 1000}, "Hz", "VINS-Fusion's rate of published tracking (read, not used: every image is tracked)"},
+      {"F_threshold", &O::F_threshold, {0, 50, true}, "px", "fundamental-matrix RANSAC threshold (the RANSAC is off, as in VINS-Fusion)"},
+      {"show_track", &O::show_track, {}, "", "VINS-Fusion's tracking image (read, not drawn here)"},
+      {"flow_back", &O::flow_back, {}, "", "forward-backward check of the temporal KLT"},
+      {"patch_refine", &O::patch_refine, {}, "", "align each track's first patch after the KLT (ours); 0 = plain KLT"},
+      // Optimization.
+      {"max_solver_time", &O::max_solver_time, {0, 3600, true}, "s", "Ceres time budget per window solve"},
+      {"max_num_iterations", &O::max_num_iterations, {1, 1000}, "", "Ceres iterations per window solve"},
+      {"keyframe_parallax", &O::keyframe_parallax, {0, 200, true}, "px", "keyframe parallax threshold at 460 px focal length"},
+      // Mono initialisation needs at least 3 frames; below 4 the window holds too little parallax.
+      {"window_size", &O::window_size, {4, 50}, "frames", "sliding window size (window_size + 1 slots)"},
+      {"reprojection_sigma_px", &O::reprojection_sigma_px, {0.1, 20}, "px", "reprojection noise at 460 px focal length"},
+      {"settle_tolerance", &O::settle_tolerance, {0, 1, true}, "", "a weight moving less than this in one step has settled (dynavins)"},
+      {"max_alternations", &O::max_alternations, {1, 20}, "", "weights <-> states rounds per window solve (dynavins)"},
+      {"zero_velocity_sigma", &O::zero_velocity_sigma, {1e-4, 1}, "m/s", "sigma of the zero-velocity factor (zupt)"},
+      {"imu_max_gap", &O::imu_max_gap, {0.01, 1}, "s", "an IMU outage longer than this resets the estimator; shorter ones are bridged"},
+      // IMU (continuous-time standard deviations).
+      {"acc_n", &O::acc_n, {0, 10, true}, "m/s^2/sqrt(Hz)", "accelerometer noise", true},
+      {"gyr_n", &O::gyr_n, {0, 10, true}, "rad/s/sqrt(Hz)", "gyroscope noise", true},
+      {"acc_w", &O::acc_w, {0, 10, true}, "m/s^3/sqrt(Hz)", "accelerometer bias random walk", true},
+      {"gyr_w", &O::gyr_w, {0, 10, true}, "rad/s^2/sqrt(Hz)", "gyroscope bias random walk", true},
+      {"g_norm", &O::g_norm, {9.5, 10}, "m/s^2", "gravity magnitude", true},
+      {"estimate_td", &O::estimate_td, {}, "", "estimate the camera-IMU time offset online (read, not used yet)"},
+      {"td", &O::td, {-1, 1}, "s", "time offset: image clock + td = IMU clock (read, not used yet)"},
+      // DynaVINS (see estimator_options.hpp for the mapping).
+      {"dyna_on", &O::dyna_on, {}, "", "per-feature weights (the authors' switch)"},
+      {"regularization_lambda", &O::regularization_gamma, {0, 100}, "", "gamma of the authors' code; lambda_w = gamma^2"},
+      {"momentum_on", &O::momentum_on, {}, "", "momentum term on the weights"},
+      {"momentum_lambda", &O::lambda_m, {0, 100}, "", "lambda_m of the momentum term"},
+      {"alternating_converge", &O::alternating_converge, {0, 1, true}, "", "share of settled weights that ends the alternation"},
+      {"margin_feature_thresh", &O::margin_feature_thresh, {0, 1}, "", "features under this weight stay out of the prior"},
+      {"weighted_huber", &O::weighted_huber, {}, "", "Huber loss under the weights (ours); 0 = the paper's eq. 4"},
+      {"zupt", &O::zupt, {}, "", "zero-velocity update (ours, OpenVINS' keys)"},
+      {"zupt_max_velocity", &O::zupt_max_velocity, {0, 10}, "m/s", "at rest only below this speed of the last solve"},
+      {"zupt_max_disparity", &O::zupt_max_disparity, {0, 50}, "px", "at rest only below this median rotation-compensated motion"},
+  };
+  return table;
+}
+
+const std::vector<std::pair<std::string, std::string>>& rigKeys() {
+  static const std::vector<std::pair<std::string, std::string>> keys{
+      {"imu", "1 with an IMU, 0 without (required)"},
+      {"num_of_cam", "1 (mono) or 2 (stereo) (required)"},
+      {"image_width", "px (required)"},
+      {"image_height", "px (required)"},
+      {"cam0_calib", "camodocs camera file, relative to the yaml (required)"},
+      {"cam1_calib", "the same for the right camera (stereo)"},
+      {"body_T_cam0", "4x4 !!opencv-matrix, camera to IMU body (may be absent with estimate_extrinsic 2)"},
+      {"body_T_cam1", "the same for the right camera (stereo)"},
+  };
+  return keys;
+}
+
+const std::vector<std::string>& knownUnusedKeys() {
+  static const std::vector<std::string> keys{
+      // VINS-Fusion (and VINS-Fusion-gpu) configs.
+      "imu_topic", "image0_topic", "image1_topic", "output_path", "multiple_thread", "load_previous_pose_graph",
+      "pose_graph_save_path", "save_image", "use_gpu", "use_gpu_acc_flow", "use_gpu_ceres",
+      // VINS-Mono configs.
+      "image_topic", "model_type", "camera_name", "distortion_parameters", "projection_parameters",
+      "extrinsicRotation", "extrinsicTranslation", "ex_calib_result_path", "equalize", "fisheye", "fisheye_mask",
+      "loop_closure", "fast_relocalization", "rolling_shutter", "rolling_shutter_tr", "visualize_imu_forward",
+      "visualize_camera_size",
+      // The authors' DynaVINS configs (visualisation, test switch and their loop closure).
+      "show_image_feat_weight", "max_depth", "test_mono", "min_score_static", "min_overlap", "max_keyframe",
+      "hypodiff_dist", "hypodiff_yaw", "hypo_regularization", "hypo_alternating_converge", "min_loop"};
+  return keys;
+}
+
 namespace {
 
-// Reads an optional key into `out`, remembering that the file set it.
-struct Loader {
-  const ConfigReader& r;
-  EstimatorOptions& o;
-  void opt(const std::string& key, int& out) {
-    if (auto v = r.find_int(key)) out = *v, o.keys_from_file.insert(key);
+constexpr const char* kOverrideSource = "--set";
+
+std::string number(double x) {
+  std::ostringstream s;
+  s << std::setprecision(10) << x;
+  return s.str();
+}
+
+template <typename T>
+std::string text(const T& v) {
+  std::ostringstream s;
+  s << std::setprecision(10) << std::boolalpha << v;
+  return s.str();
+}
+
+template <typename T>
+constexpr bool kIsFlag = std::is_same_v<T, bool>;
+
+template <typename T>
+const char* typeName() {
+  return kIsFlag<T> ? "bool" : std::is_same_v<T, int> ? "int" : "real";
+}
+
+std::string rangeText(const OptionSpec& s) {
+  return std::visit(
+      [&](auto m) -> std::string {
+        using T = std::remove_reference_t<decltype(EstimatorOptions{}.*m)>;
+        if constexpr (kIsFlag<T>) {
+          return "true/false";
+        } else {
+          return (s.range.lo_open ? "(" : "[") + number(s.range.lo) + ", " + number(s.range.hi) + "]";
+        }
+      },
+      s.field);
+}
+
+// Empty when `x` is in the key's range, else what is wrong with it.
+std::string rangeProblem(const OptionSpec& s, double x) {
+  const OptionRange& g = s.range;
+  if (!std::isfinite(x)) return "must be a finite number, got " + number(x);
+  if (x < g.lo || x > g.hi || (g.lo_open && x == g.lo))
+    return std::string("must be in ") + rangeText(s) + (*s.unit ? std::string(" ") + s.unit : "") + ", got " +
+           number(x);
+  return {};
+}
+
+const OptionSpec* findSpec(const std::string& key) {
+  for (const OptionSpec& s : optionSpecs())
+    if (key == s.key) return &s;
+  return nullptr;
+}
+
+bool isRigKey(const std::string& key) {
+  for (const auto& [k, help] : rigKeys())
+    if (k == key) return true;
+  return false;
+}
+
+std::size_t editDistance(const std::string& a, const std::string& b) {
+  std::vector<std::size_t> row(b.size() + 1);
+  for (std::size_t j = 0; j <= b.size(); ++j) row[j] = j;
+  for (std::size_t i = 1; i <= a.size(); ++i) {
+    std::size_t diag = row[0];
+    row[0] = i;
+    for (std::size_t j = 1; j <= b.size(); ++j) {
+      const std::size_t up = row[j];
+      row[j] = std::min({row[j] + 1, row[j - 1] + 1, diag + (a[i - 1] == b[j - 1] ? 0 : 1)});
+      diag = up;
+    }
   }
-  void opt(const std::string& key, double& out) {
-    if (auto v = r.find_double(key)) out = *v, o.keys_from_file.insert(key);
+  return row[b.size()];
+}
+
+// Our key closest to `key` within 2 edits, or "".
+std::string nearestKey(const std::string& key) {
+  std::string best;
+  std::size_t best_d = 3;
+  auto consider = [&](const std::string& k) {
+    const std::size_t d = editDistance(key, k);
+    if (d < best_d) best = k, best_d = d;
+  };
+  for (const OptionSpec& s : optionSpecs()) consider(s.key);
+  for (const auto& [k, help] : rigKeys()) consider(k);
+  return best;
+}
+
+void derive(EstimatorOptions& o) { o.lambda_w = o.regularization_gamma * o.regularization_gamma; }
+
+// Reads one table key from the file (absent: the default stays), checked against its range.
+void loadOption(const ConfigReader& r, EstimatorOptions& o, const OptionSpec& s) {
+  if (s.imu_only && !o.use_imu) return;
+  // VINS-Fusion reads the IMU keys unconditionally (a missing one silently becomes 0); with an IMU we insist.
+  if (!r.has(s.key)) {
+    if (s.imu_only) r.fail(s.key, "required key is missing");
+    return;
   }
-  void opt(const std::string& key, bool& out) {
-    if (auto v = r.find_bool(key)) out = *v, o.keys_from_file.insert(key);
+  std::visit(
+      [&](auto m) {
+        using T = std::remove_reference_t<decltype(o.*m)>;
+        if constexpr (kIsFlag<T>) {
+          o.*m = *r.find_bool(s.key);
+        } else {
+          T v;
+          if constexpr (std::is_same_v<T, int>) v = *r.find_int(s.key);
+          else v = *r.find_double(s.key);
+          const std::string problem = rangeProblem(s, v);
+          if (!problem.empty()) r.fail(s.key, problem);
+          o.*m = v;
+        }
+      },
+      s.field);
+  o.keys_from_file.insert(s.key);
+}
+
+// Top-level keys of the file that are neither ours nor known to be read past; each is warned.
+std::vector<std::string> unknownKeys(const ConfigReader& r) {
+  const auto& unused = knownUnusedKeys();
+  std::vector<std::string> out;
+  for (const std::string& k : r.keys()) {
+    if (findSpec(k) || isRigKey(k) || std::find(unused.begin(), unused.end(), k) != unused.end()) continue;
+    const std::string near = nearestKey(k);
+    spdlog::warn("{}: unknown key '{}' (ignored){}", r.path(), k, near.empty() ? "" : "; did you mean " + near + "?");
+    out.push_back(k);
   }
-  template <typename T>
-  void req(const std::string& key, T& out) {
-    if (!r.has(key)) r.fail(key, "required key is missing");
-    opt(key, out);
-  }
-};
+  return out;
+}
 
 }  // namespace
 
@@ -40,17 +227,19 @@ EstimatorOptions EstimatorOptions::load(const std::string& path) {
   const ConfigReader r(path);
   EstimatorOptions o;
   o.config_file = path;
-  Loader l{r, o};
-
-  l.req("imu", o.use_imu);
-  l.req("num_of_cam", o.num_of_cam);
+  auto rig = [&](const std::string& key, auto& out, auto read) {
+    out = (r.*read)(key);
+    o.keys_from_file.insert(key);
+  };
+  rig("imu", o.use_imu, &ConfigReader::get_bool);
+  rig("num_of_cam", o.num_of_cam, &ConfigReader::get_int);
   if (o.num_of_cam != 1 && o.num_of_cam != 2) r.fail("num_of_cam", "must be 1 or 2, found " + std::to_string(o.num_of_cam));
-  l.req("image_width", o.image_width);
-  l.req("image_height", o.image_height);
+  rig("image_width", o.image_width, &ConfigReader::get_int);
+  rig("image_height", o.image_height, &ConfigReader::get_int);
   if (o.image_width <= 0) r.fail("image_width", "must be positive");
   if (o.image_height <= 0) r.fail("image_height", "must be positive");
-  l.opt("estimate_extrinsic", o.estimate_extrinsic);
-  if (o.estimate_extrinsic < 0 || o.estimate_extrinsic > 2) r.fail("estimate_extrinsic", "must be 0, 1 or 2");
+
+  for (const OptionSpec& s : optionSpecs()) loadOption(r, o, s);
 
   for (int i = 0; i < o.num_of_cam; ++i) {
     const std::string calib_key = "cam" + std::to_string(i) + "_calib";
@@ -71,68 +260,29 @@ EstimatorOptions EstimatorOptions::load(const std::string& path) {
       spdlog::warn("{}: {} is {}x{} but image_width/image_height say {}x{}", path, resolved, cam.width(),
                    cam.height(), o.image_width, o.image_height);
   }
-
-  l.opt("max_cnt", o.max_cnt);
-  l.opt("min_dist", o.min_dist);
-  l.opt("freq", o.freq);
-  l.opt("F_threshold", o.F_threshold);
-  l.opt("show_track", o.show_track);
-  l.opt("flow_back", o.flow_back);
-  l.opt("patch_refine", o.patch_refine);
-  l.opt("max_solver_time", o.max_solver_time);
-  l.opt("max_num_iterations", o.max_num_iterations);
-  l.opt("keyframe_parallax", o.keyframe_parallax);
-  if (o.max_cnt <= 0) r.fail("max_cnt", "must be positive");
-  if (o.freq < 0) r.fail("freq", "must be non-negative");
-
-  if (o.use_imu) {
-    // VINS-Fusion reads these unconditionally (a missing one silently becomes 0); with an IMU we insist.
-    l.req("acc_n", o.acc_n);
-    l.req("gyr_n", o.gyr_n);
-    l.req("acc_w", o.acc_w);
-    l.req("gyr_w", o.gyr_w);
-    l.req("g_norm", o.g_norm);
-    for (const char* k : {"acc_n", "gyr_n", "acc_w", "gyr_w", "g_norm"})
-      if (!(r.get_double(k) > 0)) r.fail(k, "must be positive");
-  }
-  l.opt("estimate_td", o.estimate_td);
-  l.opt("td", o.td);
-
-  l.opt("dyna_on", o.dyna_on);
-  l.opt("regularization_lambda", o.regularization_gamma);
-  if (o.regularization_gamma < 0) r.fail("regularization_lambda", "must be non-negative");
-  o.lambda_w = o.regularization_gamma * o.regularization_gamma;
-  l.opt("momentum_on", o.momentum_on);
-  l.opt("momentum_lambda", o.lambda_m);
-  if (o.lambda_m < 0) r.fail("momentum_lambda", "must be non-negative");
-  l.opt("alternating_converge", o.alternating_converge);
-  if (o.alternating_converge <= 0 || o.alternating_converge > 1)
-    r.fail("alternating_converge", "must be in (0, 1] (fraction of converged weights)");
-  l.opt("margin_feature_thresh", o.margin_feature_thresh);
-  l.opt("weighted_huber", o.weighted_huber);
-  l.opt("zupt", o.zupt);
-  l.opt("zupt_max_velocity", o.zupt_max_velocity);
-  l.opt("zupt_max_disparity", o.zupt_max_disparity);
-  if (o.zupt_max_velocity < 0) r.fail("zupt_max_velocity", "must be non-negative [m/s]");
-  if (o.zupt_max_disparity < 0) r.fail("zupt_max_disparity", "must be non-negative [px]");
-  if (o.margin_feature_thresh < 0 || o.margin_feature_thresh > 1) r.fail("margin_feature_thresh", "must be in [0, 1]");
+  derive(o);
+  o.unknown_keys = unknownKeys(r);
   return o;
+}
+
+std::string EstimatorOptions::value(const std::string& key) const {
+  const OptionSpec* s = findSpec(key);
+  if (!s) throw ConfigError(config_file, key, "not a key of the option table");
+  return std::visit([&](auto m) { return text(this->*m); }, s->field);
 }
 
 std::string EstimatorOptions::print() const {
   std::ostringstream s;
-  s << std::setprecision(10) << std::boolalpha;
-  auto line = [&](const std::string& key, const auto& value, const char* note = "") {
+  auto line = [&](const std::string& key, const std::string& value, const std::string& note = "") {
     s << "  " << std::left << std::setw(22) << key << " = " << value << "  ("
       << (keys_from_override.count(key) ? "--set" : keys_from_file.count(key) ? "file" : "default") << ")" << note
       << "\n";
   };
   s << "Estimator options from " << config_file << ":\n";
-  line("imu", use_imu);
-  line("num_of_cam", num_of_cam);
-  line("image_width", image_width);
-  line("image_height", image_height);
-  line("estimate_extrinsic", estimate_extrinsic);
+  line("imu", text(use_imu));
+  line("num_of_cam", text(num_of_cam));
+  line("image_width", text(image_width));
+  line("image_height", text(image_height));
   for (std::size_t i = 0; i < cameras.size(); ++i) {
     const std::string n = std::to_string(i);
     line("cam" + n + "_calib", camera_files[i]);
@@ -144,43 +294,34 @@ std::string EstimatorOptions::print() const {
     T << "]";
     line("body_T_cam" + n, T.str());
   }
-  line("max_cnt", max_cnt);
-  line("min_dist", min_dist);
-  line("freq", freq);
-  line("F_threshold", F_threshold);
-  line("show_track", show_track);
-  line("flow_back", flow_back);
-  line("patch_refine", patch_refine);
-  line("max_solver_time", max_solver_time, " [s]");
-  line("max_num_iterations", max_num_iterations);
-  line("keyframe_parallax", keyframe_parallax);
-  line("window_size", window_size);
-  if (use_imu) {
-    line("acc_n", acc_n);
-    line("gyr_n", gyr_n);
-    line("acc_w", acc_w);
-    line("gyr_w", gyr_w);
-    line("g_norm", g_norm);
+  for (const OptionSpec& o : optionSpecs()) {
+    if (o.imu_only && !use_imu) continue;
+    line(o.key, value(o.key), *o.unit ? std::string(" [") + o.unit + "]" : "");
+    // The one derived option, shown under the key it comes from.
+    if (std::string(o.key) == "regularization_lambda")
+      s << "  " << std::left << std::setw(22) << "lambda_w" << " = " << text(lambda_w) << "  (derived) = gamma^2\n";
   }
-  line("estimate_td", estimate_td);
-  line("td", td, " [s]");
-  line("dyna_on", dyna_on);
-  line("regularization_lambda", regularization_gamma, " = gamma; lambda_w = gamma^2");
-  s << "  " << std::left << std::setw(22) << "lambda_w" << " = " << lambda_w << "  (derived)\n";
-  line("momentum_on", momentum_on);
-  line("momentum_lambda", lambda_m, " = lambda_m");
-  line("alternating_converge", alternating_converge);
-  line("margin_feature_thresh", margin_feature_thresh);
-  line("weighted_huber", weighted_huber);
-  line("zupt", zupt);
-  line("zupt_max_velocity", zupt_max_velocity, " [m/s]");
-  line("zupt_max_disparity", zupt_max_disparity, " [px]");
+  return s.str();
+}
+
+std::string optionsMarkdownTable() {
+  std::ostringstream s;
+  const EstimatorOptions defaults;
+  s << "| Key | Type | Default | Range | Unit | Meaning |\n";
+  s << "|---|---|---|---|---|---|\n";
+  for (const OptionSpec& o : optionSpecs()) {
+    const std::string type = std::visit(
+        [](auto m) { return std::string(typeName<std::remove_reference_t<decltype(EstimatorOptions{}.*m)>>()); },
+        o.field);
+    s << "| `" << o.key << "` | " << type << " | " << defaults.value(o.key) << " | " << rangeText(o) << " | " << o.unit
+      << " | " << o.help << (o.imu_only ? " (required with `imu: 1`)" : "") << " |\n";
+  }
+  for (const auto& [key, help] : rigKeys())
+    s << "| `" << key << "` | rig |  |  |  | " << help << "; file only, not `--set` |\n";
   return s.str();
 }
 
 namespace {
-
-constexpr const char* kOverrideSource = "--set";
 
 std::string trim(const std::string& s) {
   const auto b = s.find_first_not_of(" \t"), e = s.find_last_not_of(" \t");
@@ -199,7 +340,7 @@ double parse_double(const std::string& key, const std::string& v) {
   } catch (const std::exception&) {
     used = 0;
   }
-  if (used == 0 || used != v.size() || !std::isfinite(x)) bad(key, "expected a number, got '" + v + "'");
+  if (used == 0 || used != v.size() || !std::isfinite(x)) bad(key, "expected a finite number, got '" + v + "'");
   return x;
 }
 
@@ -221,6 +362,15 @@ bool parse_bool(const std::string& key, const std::string& v) {
   bad(key, "expected true/false/1/0, got '" + v + "'");
 }
 
+std::string unknownOverride(const std::string& key) {
+  const std::string near = nearestKey(key);
+  std::string msg = "unknown option";
+  if (!near.empty()) msg += "; did you mean " + near + "?";
+  msg += " Valid keys:";
+  for (const OptionSpec& s : optionSpecs()) msg += std::string(" ") + s.key;
+  return msg;
+}
+
 }  // namespace
 
 std::pair<std::string, std::string> EstimatorOptions::parseOverride(const std::string& text) {
@@ -233,76 +383,25 @@ std::pair<std::string, std::string> EstimatorOptions::parseOverride(const std::s
 }
 
 void EstimatorOptions::apply(const std::string& key, const std::string& value) {
-  // Each scalar key: how to parse it and which values the file loader would accept.
-  using Setter = std::function<void(EstimatorOptions&, const std::string&, const std::string&)>;
-  auto positive_int = [](int EstimatorOptions::*m) -> Setter {
-    return [m](EstimatorOptions& o, const std::string& k, const std::string& v) {
-      const int x = parse_int(k, v);
-      if (x <= 0) bad(k, "must be positive");
-      o.*m = x;
-    };
-  };
-  auto real_in = [](double EstimatorOptions::*m, double lo, double hi, bool lo_open, const char* what) -> Setter {
-    return [=](EstimatorOptions& o, const std::string& k, const std::string& v) {
-      const double x = parse_double(k, v);
-      if (x < lo || x > hi || (lo_open && x == lo)) bad(k, what);
-      o.*m = x;
-    };
-  };
-  auto flag = [](bool EstimatorOptions::*m) -> Setter {
-    return [m](EstimatorOptions& o, const std::string& k, const std::string& v) { o.*m = parse_bool(k, v); };
-  };
-  const double inf = HUGE_VAL;
-  static const std::set<std::string> fixed{"imu", "num_of_cam", "image_width", "image_height", "cam0_calib",
-                                           "cam1_calib", "body_T_cam0", "body_T_cam1"};
-  const std::map<std::string, Setter> setters{
-      {"estimate_extrinsic",
-       [](EstimatorOptions& o, const std::string& k, const std::string& v) {
-         const int x = parse_int(k, v);
-         if (x < 0 || x > 2) bad(k, "must be 0, 1 or 2");
-         o.estimate_extrinsic = x;
-       }},
-      {"max_cnt", positive_int(&EstimatorOptions::max_cnt)},
-      {"min_dist", real_in(&EstimatorOptions::min_dist, 0, inf, false, "must be non-negative")},
-      {"freq", real_in(&EstimatorOptions::freq, 0, inf, false, "must be non-negative")},
-      {"F_threshold", real_in(&EstimatorOptions::F_threshold, 0, inf, true, "must be positive")},
-      {"show_track", flag(&EstimatorOptions::show_track)},
-      {"flow_back", flag(&EstimatorOptions::flow_back)},
-      {"patch_refine", flag(&EstimatorOptions::patch_refine)},
-      {"max_solver_time", real_in(&EstimatorOptions::max_solver_time, 0, inf, true, "must be positive [s]")},
-      {"max_num_iterations", positive_int(&EstimatorOptions::max_num_iterations)},
-      {"keyframe_parallax", real_in(&EstimatorOptions::keyframe_parallax, 0, inf, true, "must be positive")},
-      {"window_size", positive_int(&EstimatorOptions::window_size)},
-      {"acc_n", real_in(&EstimatorOptions::acc_n, 0, inf, true, "must be positive")},
-      {"gyr_n", real_in(&EstimatorOptions::gyr_n, 0, inf, true, "must be positive")},
-      {"acc_w", real_in(&EstimatorOptions::acc_w, 0, inf, true, "must be positive")},
-      {"gyr_w", real_in(&EstimatorOptions::gyr_w, 0, inf, true, "must be positive")},
-      {"g_norm", real_in(&EstimatorOptions::g_norm, 0, inf, true, "must be positive")},
-      {"estimate_td", flag(&EstimatorOptions::estimate_td)},
-      {"td", real_in(&EstimatorOptions::td, -inf, inf, false, "")},
-      {"dyna_on", flag(&EstimatorOptions::dyna_on)},
-      {"regularization_lambda",
-       [](EstimatorOptions& o, const std::string& k, const std::string& v) {
-         const double x = parse_double(k, v);
-         if (x < 0) bad(k, "must be non-negative");
-         o.regularization_gamma = x;
-         o.lambda_w = x * x;
-       }},
-      {"momentum_on", flag(&EstimatorOptions::momentum_on)},
-      {"momentum_lambda", real_in(&EstimatorOptions::lambda_m, 0, inf, false, "must be non-negative")},
-      {"alternating_converge", real_in(&EstimatorOptions::alternating_converge, 0, 1, true,
-                                       "must be in (0, 1] (fraction of converged weights)")},
-      {"margin_feature_thresh",
-       real_in(&EstimatorOptions::margin_feature_thresh, 0, 1, false, "must be in [0, 1]")},
-      {"weighted_huber", flag(&EstimatorOptions::weighted_huber)},
-      {"zupt", flag(&EstimatorOptions::zupt)},
-      {"zupt_max_velocity", real_in(&EstimatorOptions::zupt_max_velocity, 0, inf, false, "must be non-negative [m/s]")},
-      {"zupt_max_disparity", real_in(&EstimatorOptions::zupt_max_disparity, 0, inf, false, "must be non-negative [px]")},
-  };
-  if (fixed.count(key)) bad(key, "describes the sensor rig and cannot be overridden; edit the yaml");
-  const auto it = setters.find(key);
-  if (it == setters.end()) bad(key, "unknown option (see the option list printed at start)");
-  it->second(*this, key, value);
+  if (isRigKey(key)) bad(key, "describes the sensor rig and cannot be overridden; edit the yaml");
+  const OptionSpec* s = findSpec(key);
+  if (!s) bad(key, unknownOverride(key));
+  std::visit(
+      [&](auto m) {
+        using T = std::remove_reference_t<decltype(this->*m)>;
+        if constexpr (kIsFlag<T>) {
+          this->*m = parse_bool(key, value);
+        } else {
+          T v;
+          if constexpr (std::is_same_v<T, int>) v = parse_int(key, value);
+          else v = parse_double(key, value);
+          const std::string problem = rangeProblem(*s, v);
+          if (!problem.empty()) bad(key, problem);
+          this->*m = v;
+        }
+      },
+      s->field);
+  derive(*this);
   keys_from_override.insert(key);
 }
 

@@ -2,6 +2,12 @@
 // Every option of the front end and estimator, loaded from a VINS-Fusion or DynaVINS yaml as the
 // user wrote it (OpenVINS style: a struct that loads and prints itself).
 //
+// Each scalar key is declared once, in the option table of estimator_options.cpp (key, field, range,
+// unit, help); its default is the field's initializer below. The yaml loader, `--set`, print() and
+// the README's key table (optionsMarkdownTable()) all read that table. Adding a key: a field here and
+// one line in the table. The rig keys (imu, num_of_cam, image_*, cam*_calib, body_T_cam*) are read
+// from the file only, explicitly in load().
+//
 // DynaVINS keys, read with the authors' code's meaning (url-kaist/dynaVINS, config/viode):
 //   regularization_lambda = gamma: their regularization residual is gamma*(1-w), so the paper's
 //                           lambda_w = gamma^2 (stored in lambda_w; the paper's default 1.0 when absent).
@@ -15,6 +21,7 @@
 #include <set>
 #include <string>
 #include <utility>
+#include <variant>
 #include <vector>
 
 #include <Eigen/Geometry>
@@ -51,6 +58,11 @@ struct EstimatorOptions {
   int max_num_iterations = 8;
   double keyframe_parallax = 10.0;  ///< pixels
   int window_size = 10;             ///< sliding window (fixed at compile time in VINS-Fusion)
+  double reprojection_sigma_px = 1.5;  ///< px at the nominal 460 px focal length (VINS-Fusion's 1.5)
+  double settle_tolerance = 0.05;  ///< a weight has settled when it moved less than this in one step
+  int max_alternations = 4;        ///< weights <-> states rounds per window solve (dynavins)
+  double zero_velocity_sigma = 0.01;  ///< m/s, of the zero-velocity factor on frames found at rest
+  double imu_max_gap = 0.1;  ///< s; a longer IMU outage inside an interval resets the estimator
 
   // IMU noise (continuous-time standard deviations); required when imu is 1.
   double acc_n = 0.1, gyr_n = 0.01, acc_w = 0.001, gyr_w = 0.0001, g_norm = 9.81;
@@ -78,6 +90,8 @@ struct EstimatorOptions {
 
   std::set<std::string> keys_from_file;      ///< which options the file set (the rest are defaults)
   std::set<std::string> keys_from_override;  ///< which options a command line `--set key=value` set
+  /// Keys of the file that are neither ours nor known VINS-Fusion / DynaVINS keys (each warned at load).
+  std::vector<std::string> unknown_keys;
 
   /// Loads `path`; throws ConfigError naming key and file on missing or wrongly typed keys.
   static EstimatorOptions load(const std::string& path);
@@ -92,6 +106,33 @@ struct EstimatorOptions {
   static std::pair<std::string, std::string> parseOverride(const std::string& text);
   /// Every effective option, one per line, with "(file)", "(--set)" or "(default)".
   std::string print() const;
+  /// The effective value of one table key as print() shows it; throws ConfigError for other keys.
+  std::string value(const std::string& key) const;
 };
+
+/// Values a numeric key accepts: [lo, hi], or (lo, hi] when lo_open.
+struct OptionRange {
+  double lo = 0, hi = 0;
+  bool lo_open = false;
+};
+
+/// One scalar key of the option table. The default is `EstimatorOptions{}.*field`.
+struct OptionSpec {
+  const char* key;
+  std::variant<bool EstimatorOptions::*, int EstimatorOptions::*, double EstimatorOptions::*> field;
+  OptionRange range;  ///< unused for flags
+  const char* unit;   ///< "" when dimensionless
+  const char* help;
+  bool imu_only = false;  ///< required with imu: 1, not read (nor printed) without
+};
+
+/// The option table, in print order.
+const std::vector<OptionSpec>& optionSpecs();
+/// The rig keys (read from the file only): name and meaning.
+const std::vector<std::pair<std::string, std::string>>& rigKeys();
+/// Keys of VINS-Fusion (and VINS-Mono, VINS-Fusion-gpu, the authors' DynaVINS) that we read past.
+const std::vector<std::string>& knownUnusedKeys();
+/// Every key of the table and the rig as a Markdown table (README.md's "Configuration keys").
+std::string optionsMarkdownTable();
 
 }  // namespace dynavins

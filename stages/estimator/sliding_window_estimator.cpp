@@ -29,10 +29,14 @@ WindowSolveOptions solveOptions(const EstimatorOptions& o, const EstimatorMode& 
   s.max_iterations = o.max_num_iterations;
   s.max_solver_time_s = o.max_solver_time;
   s.gravity = o.g_norm;
+  s.sqrt_info = kNominalFocalPx / o.reprojection_sigma_px;
   s.weights.lambda_w = o.lambda_w;
   s.weights.lambda_m = o.momentum_on ? o.lambda_m : 0.0;
   s.weights.max_momentum_count = o.window_size;
   s.alternating_converge = o.alternating_converge;
+  s.settle_tolerance = o.settle_tolerance;
+  s.max_alternations = o.max_alternations;
+  s.zero_velocity_sigma = o.zero_velocity_sigma;
   s.margin_feature_thresh = o.margin_feature_thresh;
   s.weighted_huber = o.weighted_huber;
   return s;
@@ -332,7 +336,7 @@ WindowEstimate SlidingWindowEstimator::Impl::process(const TrackedFrame& frame, 
   };
 
   if (newest >= 0 && imu == nullptr) return fail("no IMU between frames");
-  if (imu && imu->has_gap && imu->max_gap_ns > 100'000'000) {
+  if (imu && imu->has_gap && imu->max_gap_ns > std::llround(opt.imu_max_gap * 1e9)) {
     return fail("IMU gap of " + std::to_string(imu->max_gap_ns / 1'000'000) + " ms");
   }
   if (imu && imu->has_gap) e.event = "imu gap of " + std::to_string(imu->max_gap_ns / 1'000'000) + " ms bridged";

@@ -27,7 +27,7 @@ struct WindowSolveOptions {
   int max_iterations = 8;          ///< Ceres iterations per window solve (all alternations together)
   double max_solver_time_s = 0.04;
   double gravity = 9.81;
-  double sqrt_info = kNominalFocalPx / 1.5;  ///< reprojection noise σ = 1.5 px at 460 px (VINS-Fusion)
+  double sqrt_info = kNominalFocalPx / 1.5;  ///< reprojection noise σ = 1.5 px at 460 px (VINS-Fusion); key reprojection_sigma_px
   FeatureWeightParams weights;
   double alternating_converge = 0.9;  ///< share of weights that must have settled (|Δw| < settle_tol)
   double settle_tolerance = 0.05;

@@ -1,15 +1,25 @@
 // EstimatorOptions: real VINS-Fusion and DynaVINS configs load unchanged, the DynaVINS lambda
-// mapping, the sim's own configs, and errors that name the key and the file.
+// mapping, the sim's own configs, errors that name the key and the file, and the option table (every
+// key through the yaml and --set, ranges, NaN, duplicate and unknown keys, the README's table).
 
 #include <catch2/catch.hpp>
 
 #include <unistd.h>
 
+#include <algorithm>
+#include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <iomanip>
+#include <memory>
 #include <regex>
 #include <sstream>
 #include <string>
+#include <type_traits>
+#include <vector>
+
+#include <spdlog/sinks/ostream_sink.h>
+#include <spdlog/spdlog.h>
 
 #include "io/vins_config_writer.hpp"
 #include "stages/common/config_error.hpp"
@@ -184,6 +194,7 @@ TEST_CASE("The sim's own VINS-Fusion-format config loads", "[options][sim]") {
   CHECK(o.acc_n == Approx(0.08));
   CHECK(o.body_T_cam[1].translation().isApprox(Eigen::Vector3d(0.11, 0, 0)));
   CHECK(o.cameras[1]->project({0.0, 0.0, 1.0}).isApprox(Eigen::Vector2d(320, 240)));
+  CHECK(o.unknown_keys.empty());
   fs::remove_all(dir);
 }
 
@@ -228,4 +239,262 @@ TEST_CASE("Errors name the key and the file", "[options][errors]") {
     CHECK_THROWS_WITH(EstimatorOptions::load((s.dir / "nope.yaml").string()),
                       Catch::Contains("nope.yaml") && Catch::Contains("not found"));
   }
+}
+
+// ---- The option table: every key loads, overrides, range-checks and is documented the same way. ----
+
+namespace {
+
+// Text of `x` that reads back exactly.
+template <typename T>
+std::string exact(T x) {
+  std::ostringstream s;
+  s << std::setprecision(17) << std::boolalpha << x;
+  return s.str();
+}
+
+// A value of the key other than its default, inside its range, as yaml / --set text.
+std::string otherValue(const OptionSpec& s) {
+  return std::visit(
+      [&](auto m) -> std::string {
+        const auto d = EstimatorOptions{}.*m;
+        using T = std::remove_const_t<decltype(d)>;
+        if constexpr (std::is_same_v<T, bool>) {
+          return d ? "false" : "true";
+        } else if constexpr (std::is_same_v<T, int>) {
+          return std::to_string(d + 1 <= s.range.hi ? d + 1 : d - 1);
+        } else {
+          return exact(d < s.range.hi ? (d + s.range.hi) / 2 : (s.range.lo + d) / 2);
+        }
+      },
+      s.field);
+}
+
+// Values of the key outside its range (flags: not a flag at all).
+std::vector<std::string> badValues(const OptionSpec& s) {
+  return std::visit(
+      [&](auto m) -> std::vector<std::string> {
+        using T = std::remove_reference_t<decltype(EstimatorOptions{}.*m)>;
+        if constexpr (std::is_same_v<T, bool>) {
+          return {"2"};
+        } else {
+          const double step = std::is_same_v<T, int> ? 1.0 : std::max(1e-3, 0.5 * s.range.hi);
+          return {exact(T(s.range.hi + step)), exact(T(s.range.lo_open ? s.range.lo : s.range.lo - step))};
+        }
+      },
+      s.field);
+}
+
+// `text` without its top-level lines for `keys`, then "key: value" for each.
+std::string withKeys(const std::string& text, const std::vector<std::pair<std::string, std::string>>& kv) {
+  std::istringstream in(text);
+  std::ostringstream out;
+  for (std::string line; std::getline(in, line);) {
+    bool drop = false;
+    for (const auto& [k, v] : kv) drop = drop || line.rfind(k + ":", 0) == 0;
+    if (!drop) out << line << "\n";
+  }
+  for (const auto& [k, v] : kv) out << k << ": " << v << "\n";
+  return out.str();
+}
+
+// The "(file)" / "(--set)" / "(default)" mark print() gives `key`.
+std::string sourceOf(const std::string& printed, const std::string& key) {
+  const std::regex line("\n  " + key + " += [^\n]*  \\(([-a-z]+)\\)");
+  std::smatch m;
+  return std::regex_search(printed, m, line) ? m[1].str() : "(not printed)";
+}
+
+// The default logger's output while alive.
+struct LogCapture {
+  std::ostringstream text;
+  std::shared_ptr<spdlog::sinks::ostream_sink_mt> sink = std::make_shared<spdlog::sinks::ostream_sink_mt>(text);
+  LogCapture() { spdlog::default_logger()->sinks().push_back(sink); }
+  ~LogCapture() {
+    auto& sinks = spdlog::default_logger()->sinks();
+    sinks.erase(std::remove(sinks.begin(), sinks.end(), sink), sinks.end());
+  }
+};
+
+template <typename T>
+bool sameValue(T field, const std::string& written) {
+  if constexpr (std::is_same_v<T, bool>) return field == (written == "true");
+  if constexpr (std::is_same_v<T, int>) return field == std::stoi(written);
+  return field == std::stod(written);
+}
+
+}  // namespace
+
+TEST_CASE("The new keys default to the values the estimator used before they were keys", "[options][table]") {
+  const EstimatorOptions o;
+  CHECK(o.reprojection_sigma_px == 1.5);
+  CHECK(o.settle_tolerance == 0.05);
+  CHECK(o.max_alternations == 4);
+  CHECK(o.zero_velocity_sigma == 0.01);
+  CHECK(o.imu_max_gap == 0.1);
+  CHECK(std::llround(o.imu_max_gap * 1e9) == 100'000'000);  // the 100 ms it replaces, exactly
+  CHECK(460.0 / o.reprojection_sigma_px == 460.0 / 1.5);
+}
+
+TEST_CASE("Every key of the table and the rig, set in the yaml, takes effect and is marked (file)", "[options][table]") {
+  ScratchConfig s(kEuroc);
+  std::vector<std::pair<std::string, std::string>> kv;
+  for (const OptionSpec& spec : optionSpecs()) kv.emplace_back(spec.key, otherValue(spec));
+  // The rig keys the EuRoC file does not already carry with other values than the defaults.
+  kv.emplace_back("cam0_calib", "\"cam0_pinhole.yaml\"");
+  kv.emplace_back("cam1_calib", "\"cam1_pinhole.yaml\"");
+  const std::string path = (s.dir / "every_key.yaml").string();
+  std::ofstream(path) << withKeys(slurp((s.dir / "euroc_stereo_imu_config.yaml").string()), kv);
+
+  const auto o = EstimatorOptions::load(path);
+  const std::string printed = o.print();
+  for (const OptionSpec& spec : optionSpecs()) {
+    const std::string written = otherValue(spec);
+    INFO(spec.key << " written " << written << ", loaded " << o.value(spec.key));
+    CHECK(std::visit([&](auto m) { return sameValue(o.*m, written); }, spec.field));
+    CHECK(sourceOf(printed, spec.key) == "file");
+  }
+  CHECK(o.lambda_w == o.regularization_gamma * o.regularization_gamma);
+  CHECK(o.use_imu);
+  CHECK(o.num_of_cam == 2);
+  CHECK(o.image_width == 752);
+  CHECK(o.cameras[0]->name() == "PINHOLE");
+  CHECK(o.cameras[1]->name() == "PINHOLE");
+  CHECK(o.body_T_cam[1](0, 3) == Approx(-0.0198435579556));
+  for (const auto& [key, help] : rigKeys()) {
+    INFO(key);
+    CHECK(sourceOf(printed, key) == "file");
+  }
+  CHECK(o.unknown_keys.empty());
+}
+
+TEST_CASE("Every key of the table, set with --set, takes effect and is marked (--set)", "[options][table]") {
+  std::vector<std::pair<std::string, std::string>> kv;
+  for (const OptionSpec& spec : optionSpecs()) kv.emplace_back(spec.key, otherValue(spec));
+  const auto o = EstimatorOptions::load(kEuroc + "euroc_stereo_imu_config.yaml", kv);
+  const std::string printed = o.print();
+  for (const auto& [key, written] : kv) {
+    INFO(key << " set " << written << ", got " << o.value(key));
+    const OptionSpec& spec = *std::find_if(optionSpecs().begin(), optionSpecs().end(),
+                                          [&](const OptionSpec& x) { return key == x.key; });
+    CHECK(std::visit([&](auto m) { return sameValue(o.*m, written); }, spec.field));
+    CHECK(sourceOf(printed, key) == "--set");
+  }
+  CHECK(o.lambda_w == o.regularization_gamma * o.regularization_gamma);
+  CHECK(sourceOf(printed, "imu") == "file");
+}
+
+TEST_CASE("Each key's out-of-range value is rejected on load and on --set, naming the key", "[options][table]") {
+  ScratchConfig s(kEuroc);
+  const std::string base = slurp((s.dir / "euroc_stereo_imu_config.yaml").string());
+  const std::string path = (s.dir / "bad_value.yaml").string();
+  EstimatorOptions o = EstimatorOptions::load(kEuroc + "euroc_stereo_imu_config.yaml");
+  const std::string before = o.print();
+  for (const OptionSpec& spec : optionSpecs()) {
+    for (const std::string& v : badValues(spec)) {
+      INFO(spec.key << ": " << v);
+      std::ofstream(path) << withKeys(base, {{spec.key, v}});
+      CHECK_THROWS_WITH(EstimatorOptions::load(path),
+                        Catch::Contains(path) && Catch::Contains(std::string("'") + spec.key + "'"));
+      CHECK_THROWS_WITH(o.apply(spec.key, v), Catch::Contains("--set") && Catch::Contains(std::string("'") + spec.key + "'"));
+    }
+  }
+  CHECK(o.print() == before);  // nothing applied by the failed calls
+}
+
+TEST_CASE("window_size 1 and 100000000 are rejected", "[options][table]") {
+  ScratchConfig s(kEuroc);
+  EstimatorOptions o = EstimatorOptions::load(kEuroc + "euroc_stereo_imu_config.yaml");
+  for (const char* v : {"1", "100000000"}) {
+    INFO(v);
+    const std::string path = s.edit("euroc_stereo_imu_config.yaml", "keyframe_parallax: 10.0",
+                                    std::string("keyframe_parallax: 10.0\nwindow_size: ") + v);
+    CHECK_THROWS_WITH(EstimatorOptions::load(path), Catch::Contains("'window_size'") && Catch::Contains("[4, 50]"));
+    CHECK_THROWS_WITH(o.apply("window_size", v), Catch::Contains("'window_size'") && Catch::Contains("[4, 50]"));
+  }
+  const std::string ok = s.edit("euroc_stereo_imu_config.yaml", "keyframe_parallax: 10.0",
+                                "keyframe_parallax: 10.0\nwindow_size: 12");
+  CHECK(EstimatorOptions::load(ok).window_size == 12);  // read from the yaml, not only from --set
+  CHECK(sourceOf(EstimatorOptions::load(ok).print(), "window_size") == "file");
+}
+
+TEST_CASE("NaN and Inf in the config are rejected naming the key and the file", "[options][table]") {
+  ScratchConfig s(kEuroc);
+  for (const char* v : {".nan", ".inf", "-.inf"}) {
+    INFO(v);
+    const std::string a = s.edit("euroc_stereo_imu_config.yaml", "max_solver_time: 0.04", std::string("max_solver_time: ") + v);
+    CHECK_THROWS_WITH(EstimatorOptions::load(a), Catch::Contains(a) && Catch::Contains("'max_solver_time'"));
+    const std::string b = s.edit("euroc_stereo_imu_config.yaml", "acc_n: 0.1", std::string("acc_n: ") + v);
+    CHECK_THROWS_WITH(EstimatorOptions::load(b), Catch::Contains(b) && Catch::Contains("'acc_n'"));
+    const std::string c = s.edit("euroc_stereo_imu_config.yaml", "td: 0.0", std::string("td: ") + v);
+    CHECK_THROWS_WITH(EstimatorOptions::load(c), Catch::Contains(c) && Catch::Contains("'td'") && Catch::Contains("finite"));
+  }
+  EstimatorOptions o = EstimatorOptions::load(kEuroc + "euroc_stereo_imu_config.yaml");
+  CHECK_THROWS_WITH(o.apply("td", "nan"), Catch::Contains("'td'"));
+  CHECK_THROWS_WITH(o.apply("td", "inf"), Catch::Contains("'td'"));
+}
+
+TEST_CASE("A key written twice is an error naming the key and the file", "[options][table]") {
+  ScratchConfig s(kEuroc);
+  const std::string path = s.edit("euroc_stereo_imu_config.yaml", "keyframe_parallax: 10.0",
+                                  "keyframe_parallax: 10.0\nmax_cnt: 200");
+  CHECK_THROWS_WITH(EstimatorOptions::load(path), Catch::Contains(path) && Catch::Contains("'max_cnt'") &&
+                                                      Catch::Contains("more than once"));
+}
+
+TEST_CASE("An unknown yaml key is warned, naming it and the file, with the nearest key", "[options][table]") {
+  ScratchConfig s(kViode);
+  const std::string path = s.edit("calibration_stereo.yaml", "momentum_lambda:   0.2",
+                                  "momentum_lamda:   0.3\nmy_own_setting: 1");
+  LogCapture log;
+  const auto o = EstimatorOptions::load(path);
+  CHECK(o.unknown_keys == std::vector<std::string>{"momentum_lamda", "my_own_setting"});
+  CHECK(o.lambda_m == 0.2);  // the misspelt key is not read
+  const std::string text = log.text.str();
+  CHECK_THAT(text, Catch::Contains(path) && Catch::Contains("'momentum_lamda'") &&
+                       Catch::Contains("did you mean momentum_lambda?"));
+  CHECK_THAT(text, Catch::Contains("'my_own_setting'"));
+  CHECK(text.find("my_own_setting' (ignored);") == std::string::npos);  // nothing close to it
+}
+
+TEST_CASE("An unknown --set key names the nearest key and lists the valid ones", "[options][table]") {
+  EstimatorOptions o = EstimatorOptions::load(kEuroc + "euroc_stereo_imu_config.yaml");
+  CHECK_THROWS_WITH(o.apply("momentum_lamda", "1"),
+                    Catch::Contains("did you mean momentum_lambda?") && Catch::Contains("max_cnt") &&
+                        Catch::Contains("imu_max_gap") && !Catch::Contains("option list printed at start"));
+  CHECK_THROWS_WITH(o.apply("zzzzzzzz", "1"), Catch::Contains("Valid keys:") && !Catch::Contains("did you mean"));
+}
+
+TEST_CASE("Every shipped config in the shared data loads without unknown keys", "[options][table]") {
+  const fs::path data = fs::path(DYNAVINS_SHARED_DIR) / "data";
+  if (!fs::is_directory(data)) {
+    WARN("no " << data << ": skipped");
+    return;
+  }
+  int configs = 0;
+  for (const auto& e : fs::recursive_directory_iterator(data)) {
+    if (e.path().extension() != ".yaml") continue;
+    // Estimator configs only: camera files and EuRoC's sensor.yaml are read by their own loaders.
+    if (slurp(e.path().string()).find("\nnum_of_cam") == std::string::npos) continue;
+    INFO(e.path());
+    LogCapture log;
+    const auto o = EstimatorOptions::load(e.path().string());
+    CHECK(o.unknown_keys.empty());
+    CHECK(log.text.str().find("unknown key") == std::string::npos);
+    ++configs;
+  }
+  CHECK(configs >= 5);
+}
+
+TEST_CASE("README.md's key table is the one the code generates", "[options][table]") {
+  const std::string readme = slurp(std::string(DYNAVINS_SOURCE_DIR) + "/README.md");
+  const std::string begin = "<!-- options-table:begin (dynavins info --options-markdown) -->\n";
+  const std::string end = "<!-- options-table:end -->";
+  const auto b = readme.find(begin), e = readme.find(end);
+  REQUIRE(b != std::string::npos);
+  REQUIRE(e != std::string::npos);
+  const std::string table = readme.substr(b + begin.size(), e - b - begin.size());
+  // On a failure, paste `build/bin/dynavins info --options-markdown` between the markers.
+  CHECK(table == optionsMarkdownTable());
+  for (const OptionSpec& spec : optionSpecs()) CHECK_THAT(table, Catch::Contains(std::string("| `") + spec.key + "` |"));
 }

@@ -45,7 +45,7 @@ TEST_CASE("override: --set rejects malformed text, unknown keys, bad values and 
   EstimatorOptions o = EstimatorOptions::load(kStereo);
   CHECK_THROWS_AS(o.apply("max_cnt", "12x"), ConfigError);
   CHECK_THROWS_WITH(o.apply("max_cnt", "12x"), Contains("--set") && Contains("'max_cnt'") && Contains("12x"));
-  CHECK_THROWS_WITH(o.apply("max_cnt", "0"), Contains("'max_cnt'") && Contains("positive"));
+  CHECK_THROWS_WITH(o.apply("max_cnt", "0"), Contains("'max_cnt'") && Contains("must be in [10, 2000]"));
   CHECK_THROWS_WITH(o.apply("no_such_option", "1"), Contains("--set") && Contains("'no_such_option'") && Contains("unknown"));
   CHECK_THROWS_WITH(o.apply("dyna_on", "yes"), Contains("'dyna_on'") && Contains("true/false"));
   CHECK_THROWS_WITH(o.apply("alternating_converge", "1.5"), Contains("'alternating_converge'"));
