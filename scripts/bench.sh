@@ -5,8 +5,8 @@
 #   full  (make bench):       every scenario of bench/scenarios at full length (40-85 s), and `none`
 #                             and `high` again at noise seeds 12 to 17 -> bench/results/
 #   quick (make bench-quick): `none` and `high` cut to 20 s (cached as NAME-20s) -> bench/results/quick/
-# Every run: `dynavins run --rate 0 --set max_solver_time=1000` (lossless replay, solves bounded by
-# iterations only), so accuracy does not depend on machine load. A failed run is recorded as failed
+# Every run: `dynavins run --rate 0` (lossless replay; at rate 0 the solves are bounded by iterations
+# only), so accuracy does not depend on machine load. A failed run is recorded as failed
 # (manifest + report) and the bench goes on; it exits 1 at the end when a scene or run crashed.
 # Only the full bench rewrites the README headline.
 # DYNAVINS=path/to/dynavins (default build/bin/dynavins); BENCH_TRACKER=path/to/bench_tracker
@@ -103,7 +103,7 @@ run_one() {
   local data=bench/cache/$scene_cache/euroc
   local dir=$out/runs/$sc/$mode-$ba${variant:+-$variant}
   local cmd=("$bin" run --config "$data/vins_config.yaml" --euroc "$data" --ba "$ba" --rate 0
-             --set max_solver_time=1000 "$@" --out "$dir")
+             "$@" --out "$dir")
   [ "$mode" = mono ] && cmd+=(--mono)
   mkdir -p "$dir"
   timed "$sc $mode $ba${variant:+ ($variant)}" "$dir/run.log" timeout 1800 "${cmd[@]}"

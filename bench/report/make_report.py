@@ -659,8 +659,8 @@ def write_report(results_dir, meta, manifest, runs, figures):
           f"| binary | `{meta.get('binary', '?')}` |",
           f"| scene options | `{meta.get('sim_args') or '(scenario defaults)'}` |",
           f"| runs | {len(runs)} ({n_fail} not ok), bench wall time {meta.get('bench_wall_s', '?')} s |", ""]
-    L += ["Every run is `dynavins run --rate 0 --set max_solver_time=1000`: lossless blocking replay and "
-          "window solves bounded by Ceres iterations only, so accuracy does not depend on machine load. "
+    L += ["Every run is `dynavins run --rate 0`: lossless blocking replay and "
+          "window solves bounded by Ceres iterations only (at rate 0 the config's `max_solver_time` is not applied), so accuracy does not depend on machine load. "
           f"A run is **✗ scene not generated** when `cached-sim.sh` failed for its scene, **✗ run error** when it exited non-zero or its summary says `ok=false`, **✗ lost** when "
           f"fewer than {LOST_TRACKING_SHARE:.0%} of its frames were tracking, **✗ diverged** when its SE3 ATE "
           f"exceeds {DIVERGED_PATH_SHARE:.0%} of the ground-truth path length; estimator resets are marked "
