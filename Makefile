@@ -49,9 +49,9 @@ test: build
 test-unit: build
 	ctest --test-dir $(BUILD) --output-on-failure -j $(CTEST_J)
 
-# The whole suite under ThreadSanitizer (separate build tree; -O1 -g).
+# The whole suite under ThreadSanitizer (separate build tree; -O1 -g1), but for the tests labelled heavy.
 test-tsan: deps
-	cmake -S . -B $(TSAN_BUILD) $(CMAKE_GEN) -DCMAKE_BUILD_TYPE=RelWithDebInfo -DDYNAVINS_TSAN=ON -DDYNAVINS_HEAVY_TESTS=OFF -DDYNAVINS_BUILD_BENCH=OFF -DDYNAVINS_BUILD_CLI=OFF
+	cmake -S . -B $(TSAN_BUILD) $(CMAKE_GEN) -DCMAKE_BUILD_TYPE=Release -DDYNAVINS_TSAN=ON -DDYNAVINS_HEAVY_TESTS=OFF -DDYNAVINS_BUILD_BENCH=OFF -DDYNAVINS_BUILD_CLI=OFF
 	cmake --build $(TSAN_BUILD)
 	TSAN_OPTIONS="halt_on_error=1 second_deadlock_stack=1 suppressions=$(CURDIR)/tests/tsan.supp" \
 	  ctest --test-dir $(TSAN_BUILD) --output-on-failure -j $(CTEST_J) -LE heavy
