@@ -82,7 +82,7 @@ void run(const RunCommandOptions& o) {
                o.rate > 0 ? fmt::format("{}x real time", o.rate) : std::string("as fast as possible"),
                opt.gyro_prediction ? "on" : "off", out_dir);
 
-  auto source = o.input.open();
+  auto source = o.input.open(/*need_stereo=*/opt.mode.stereo);
   std::unique_ptr<pipeline::RunOutputs> outputs;
   try {
     outputs = std::make_unique<pipeline::RunOutputs>(out_dir);

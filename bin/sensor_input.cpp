@@ -18,9 +18,15 @@ void SensorInput::add_options(CLI::App& cmd, bool with_log) {
   group->require_option(1);
 }
 
-std::unique_ptr<io::SensorSource> SensorInput::open() const {
+std::unique_ptr<io::SensorSource> SensorInput::open(bool need_stereo) const {
   try {
-    if (!euroc.empty()) return std::make_unique<io::EurocSource>(std::make_shared<io::EurocDataset>(euroc));
+    if (!euroc.empty()) {
+      auto dataset = std::make_shared<io::EurocDataset>(euroc);
+      if (need_stereo && !dataset->stereo())
+        throw CommandError(euroc + ": no mav0/cam1 folder, but the run is stereo (num_of_cam: 2); pass --mono to "
+                           "run on cam0 only", 2);
+      return std::make_unique<io::EurocSource>(dataset);
+    }
     if (!rosbag.empty()) return std::make_unique<io::RosbagReader>(rosbag);
     return std::make_unique<pipeline::LcmLogSource>(log);
   } catch (const std::runtime_error& e) {

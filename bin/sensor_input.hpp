@@ -20,8 +20,9 @@ struct SensorInput {
 
   /// Adds the options to `cmd`, mutually exclusive, one required.
   void add_options(CLI::App& cmd, bool with_log);
-  /// Opens the chosen input; throws CommandError (exit 2) on bad input.
-  std::unique_ptr<io::SensorSource> open() const;
+  /// Opens the chosen input; throws CommandError (exit 2) on bad input, and when `need_stereo` and an
+  /// EuRoC folder has no cam1 (a stereo run must not quietly become a mono one).
+  std::unique_ptr<io::SensorSource> open(bool need_stereo = false) const;
 };
 
 }  // namespace dynavins::cli

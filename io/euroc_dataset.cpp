@@ -26,11 +26,13 @@ void check_increasing(int64_t t, int64_t& last, const std::string& file, std::si
   last = t;
 }
 
-/// Reads a camera's data.csv. Rows whose image file is absent are skipped and counted in
-/// `missing` (real EuRoC extracts list images that were not shipped), with a warning naming the first.
-std::vector<ImageEntry> read_camera(const fs::path& cam_dir, std::size_t& missing) {
+/// Reads a camera's data.csv. Rows whose image file is absent are skipped and added to `missing`
+/// (real EuRoC extracts list images that were not shipped), with a warning naming this camera's first
+/// and a count of this camera's own.
+std::vector<ImageEntry> read_camera(const fs::path& cam_dir, std::size_t& missing_total) {
   const std::string csv = (cam_dir / "data.csv").string();
   std::vector<ImageEntry> out;
+  std::size_t missing = 0;
   int64_t last = INT64_MIN;
   for (const auto& row : read_csv(csv, 2)) {
     const int64_t t = parse_int64(row.fields[0], csv, row.line, "timestamp");
@@ -43,6 +45,7 @@ std::vector<ImageEntry> read_camera(const fs::path& cam_dir, std::size_t& missin
     out.push_back({t, image.string()});
   }
   if (missing > 1) spdlog::warn("{}: {} listed images do not exist; skipped", csv, missing);
+  missing_total += missing;
   if (out.empty()) throw InputError(csv, 0, "lists no image that exists");
   return out;
 }

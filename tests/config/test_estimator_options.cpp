@@ -18,12 +18,12 @@
 #include <type_traits>
 #include <vector>
 
-#include <spdlog/sinks/ostream_sink.h>
 #include <spdlog/spdlog.h>
 
 #include "io/vins_config_writer.hpp"
 #include "stages/common/config_error.hpp"
 #include "stages/common/estimator_options.hpp"
+#include "tests/log_capture.hpp"
 
 using namespace dynavins;
 namespace fs = std::filesystem;
@@ -305,16 +305,7 @@ std::string sourceOf(const std::string& printed, const std::string& key) {
   return std::regex_search(printed, m, line) ? m[1].str() : "(not printed)";
 }
 
-// The default logger's output while alive.
-struct LogCapture {
-  std::ostringstream text;
-  std::shared_ptr<spdlog::sinks::ostream_sink_mt> sink = std::make_shared<spdlog::sinks::ostream_sink_mt>(text);
-  LogCapture() { spdlog::default_logger()->sinks().push_back(sink); }
-  ~LogCapture() {
-    auto& sinks = spdlog::default_logger()->sinks();
-    sinks.erase(std::remove(sinks.begin(), sinks.end(), sink), sinks.end());
-  }
-};
+using test::LogCapture;
 
 template <typename T>
 bool sameValue(T field, const std::string& written) {

@@ -7,6 +7,7 @@
 #include "io/euroc_dataset.hpp"
 #include "io/euroc_source.hpp"
 #include "io/input_error.hpp"
+#include "tests/log_capture.hpp"
 
 using namespace dynavins;
 using namespace dynavins::io;
@@ -95,6 +96,21 @@ TEST_CASE("EurocDataset: bad input is an error naming the file and line", "[euro
     CHECK(d.missing_images() == 1);
     CHECK(d.frames().size() == 2);
     CHECK(d.unmatched_left() == 1);
+  }
+  SECTION("missing images are counted per camera in the warnings, and in total") {
+    const auto root = make_folder("missing_both");
+    fs::remove(root / "mav0/cam0/data/1000000000.png");
+    fs::remove(root / "mav0/cam1/data/1000000000.png");
+    fs::remove(root / "mav0/cam1/data/1050000000.png");
+    test::LogCapture log;
+    EurocDataset d(root.string());
+    CHECK(d.missing_images() == 3);
+    const std::string text = log.text.str();
+    INFO(text);
+    CHECK(text.find("cam0/data.csv:2: image") != std::string::npos);
+    CHECK(text.find("cam0/data.csv: ") == std::string::npos);  // one missing: no total line for cam0
+    CHECK(text.find("cam1/data.csv:2: image") != std::string::npos);
+    CHECK(text.find("cam1/data.csv: 2 listed images do not exist") != std::string::npos);
   }
   SECTION("wrong column count") {
     const auto root = make_folder("columns");
