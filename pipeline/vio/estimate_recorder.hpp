@@ -9,7 +9,7 @@
 #include "eval/trajectory.hpp"
 #include "eval/weight_score.hpp"
 #include "messages/sensor_messages.hpp"
-#include "stages/estimator/window_estimate.hpp"
+#include "messages/window_estimate.hpp"
 
 namespace dynavins::pipeline {
 

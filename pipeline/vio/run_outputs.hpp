@@ -16,7 +16,7 @@
 
 #include "eval/trajectory.hpp"
 #include "pipeline/vio/vio_pipeline.hpp"
-#include "stages/estimator/window_estimate.hpp"
+#include "messages/window_estimate.hpp"
 
 namespace dynavins::pipeline {
 

@@ -34,7 +34,7 @@
 #include "pipeline/stop_flag.hpp"
 #include "stages/common/estimator_options.hpp"
 #include "stages/estimator/sliding_window_estimator.hpp"
-#include "stages/estimator/window_estimate.hpp"
+#include "messages/window_estimate.hpp"
 #include "stages/imu/frame_imu_pairer.hpp"
 #include "stages/imu/imu_stage.hpp"
 

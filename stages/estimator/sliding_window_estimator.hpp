@@ -7,9 +7,9 @@
 
 #include "stages/common/estimator_options.hpp"
 #include "stages/estimator/ba_mode.hpp"
-#include "stages/estimator/window_estimate.hpp"
+#include "messages/window_estimate.hpp"
 #include "messages/tracked_frame.hpp"
-#include "stages/imu/preintegrated_interval.hpp"
+#include "messages/preintegrated_interval.hpp"
 
 namespace dynavins::estimator {
 

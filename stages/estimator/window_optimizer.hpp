@@ -13,7 +13,7 @@
 
 #include "stages/estimator/ba_mode.hpp"
 #include "stages/estimator/feature_weights.hpp"
-#include "stages/estimator/window_estimate.hpp"
+#include "messages/window_estimate.hpp"
 #include "stages/estimator/window_features.hpp"
 #include "stages/estimator/window_state.hpp"
 

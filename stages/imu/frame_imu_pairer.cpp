@@ -6,15 +6,19 @@
 
 #include <spdlog/spdlog.h>
 
+#include "stages/imu/imu_preintegration.hpp"
+
 namespace dynavins {
 
 void appendInterval(PreintegratedInterval& first, const PreintegratedInterval& later) {
   if (later.t_begin_ns != first.t_end_ns)
     throw std::invalid_argument("appendInterval: interval starting at " + std::to_string(later.t_begin_ns) +
                                 " ns does not continue one ending at " + std::to_string(first.t_end_ns) + " ns");
-  const std::vector<ImuSample>& s = later.preint.samples();
+  const std::vector<ImuSample>& s = later.preint.samples;
   // s[0] is later's start, interpolated at the shared frame time: first already ends with it.
-  for (std::size_t i = 1; i < s.size(); ++i) first.preint.integrate(s[i]);
+  ImuPreintegration pre(first.preint);
+  for (std::size_t i = 1; i < s.size(); ++i) pre.integrate(s[i]);
+  first.preint = pre.deltas();
   first.t_end_ns = later.t_end_ns;
   first.has_gap = first.has_gap || later.has_gap;
   first.max_gap_ns = std::max(first.max_gap_ns, later.max_gap_ns);

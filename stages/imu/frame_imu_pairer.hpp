@@ -21,7 +21,7 @@
 #include <vector>
 
 #include "messages/tracked_frame.hpp"
-#include "stages/imu/preintegrated_interval.hpp"
+#include "messages/preintegrated_interval.hpp"
 
 namespace dynavins {
 

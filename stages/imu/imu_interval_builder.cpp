@@ -6,6 +6,7 @@
 
 #include <spdlog/spdlog.h>
 
+#include "stages/imu/imu_preintegration.hpp"
 #include "stages/imu/imu_sample_interpolation.hpp"
 
 namespace dynavins {
@@ -75,14 +76,15 @@ PreintegratedInterval ImuIntervalBuilder::build(int64_t t0, int64_t t1) const {
   iv.t_begin_ns = t0;
   iv.t_end_ns = t1;
   const ImuSample start = (imu_[i0].t_ns == t0) ? imu_[i0] : interpolate(imu_[i0], imu_[i0 + 1], t0);
-  iv.preint = ImuPreintegration(start, ba_, bg_, opt_.noise);
+  ImuPreintegration pre(start, ba_, bg_, opt_.noise);
   size_t k = i0 + 1;
   for (; k < imu_.size() && imu_[k].t_ns < t1; ++k) {
-    iv.preint.integrate(imu_[k]);
+    pre.integrate(imu_[k]);
     ++iv.num_raw_samples;
   }
   // imu_[k] is the first sample at or after t1 (exists: drain() checked imu_.back() >= t1).
-  iv.preint.integrate(interpolate(imu_[k - 1], imu_[k], t1));
+  pre.integrate(interpolate(imu_[k - 1], imu_[k], t1));
+  iv.preint = pre.deltas();
   if (imu_[k].t_ns == t1) ++iv.num_raw_samples;
   for (size_t m = i0 + 1; m <= k; ++m) iv.max_gap_ns = std::max(iv.max_gap_ns, imu_[m].t_ns - imu_[m - 1].t_ns);
   iv.has_gap = iv.max_gap_ns > gap_threshold_ns_;

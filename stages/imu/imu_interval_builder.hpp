@@ -15,7 +15,7 @@
 
 #include "messages/sensor_messages.hpp"
 #include "stages/imu/imu_noise_params.hpp"
-#include "stages/imu/preintegrated_interval.hpp"
+#include "messages/preintegrated_interval.hpp"
 
 namespace dynavins {
 

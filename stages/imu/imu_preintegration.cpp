@@ -35,6 +35,37 @@ ImuPreintegration::ImuPreintegration(const ImuSample& first, const Eigen::Vector
   noise_cov_.block<3, 3>(15, 15) = noise.gyr_w * noise.gyr_w * I;
 }
 
+ImuPreintegration::ImuPreintegration(const PreintegratedDeltas& d)
+    : ImuPreintegration(d.samples.empty() ? ImuSample{} : d.samples.front(), d.ba, d.bg,
+                        ImuNoiseParams{d.acc_n, d.gyr_n, d.acc_w, d.gyr_w}) {
+  if (d.samples.empty()) samples_.clear();
+  else samples_ = d.samples;
+  alpha_ = d.alpha;
+  gamma_ = d.gamma;
+  beta_ = d.beta;
+  covariance_ = d.covariance;
+  jacobian_ = d.jacobian;
+  sum_dt_ = d.sum_dt;
+}
+
+PreintegratedDeltas ImuPreintegration::deltas() const {
+  PreintegratedDeltas d;
+  d.samples = samples_;
+  d.ba = ba_;
+  d.bg = bg_;
+  d.acc_n = noise_.acc_n;
+  d.gyr_n = noise_.gyr_n;
+  d.acc_w = noise_.acc_w;
+  d.gyr_w = noise_.gyr_w;
+  d.alpha = alpha_;
+  d.gamma = gamma_;
+  d.beta = beta_;
+  d.covariance = covariance_;
+  d.jacobian = jacobian_;
+  d.sum_dt = sum_dt_;
+  return d;
+}
+
 void ImuPreintegration::reset() {
   alpha_.setZero();
   beta_.setZero();

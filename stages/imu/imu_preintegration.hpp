@@ -12,6 +12,7 @@
 #include <Eigen/Core>
 #include <Eigen/Geometry>
 
+#include "messages/preintegrated_interval.hpp"
 #include "messages/sensor_messages.hpp"
 #include "stages/imu/imu_noise_params.hpp"
 
@@ -28,6 +29,11 @@ class ImuPreintegration {
   /// Starts an interval at `first.t_ns` with linearisation biases (ba, bg).
   ImuPreintegration(const ImuSample& first, const Eigen::Vector3d& ba, const Eigen::Vector3d& bg,
                     const ImuNoiseParams& noise);
+  /// Resumes the preintegration `d` describes (as deltas() exported it): the same state, bit for bit.
+  explicit ImuPreintegration(const PreintegratedDeltas& d);
+
+  /// The whole state as plain data, for the PreintegratedInterval message.
+  PreintegratedDeltas deltas() const;
 
   /// Adds the next sample (t_ns must be > the last one's, else std::invalid_argument) and integrates the
   /// step from the previous sample with the midpoint rule.

@@ -12,7 +12,7 @@
 #include "messages/sensor_messages.hpp"
 #include "stages/common/estimator_options.hpp"
 #include "stages/imu/imu_interval_builder.hpp"
-#include "stages/imu/preintegrated_interval.hpp"
+#include "messages/preintegrated_interval.hpp"
 
 namespace dynavins {
 

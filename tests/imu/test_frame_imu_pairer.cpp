@@ -54,12 +54,12 @@ void append(std::vector<FrameWithImu>& out, std::vector<FrameWithImu> more) {
 void requireSameDeltas(const PreintegratedInterval& a, const PreintegratedInterval& b) {
   REQUIRE(a.t_begin_ns == b.t_begin_ns);
   REQUIRE(a.t_end_ns == b.t_end_ns);
-  CHECK((a.preint.deltaP() - b.preint.deltaP()).norm() < 1e-9);
-  CHECK((a.preint.deltaV() - b.preint.deltaV()).norm() < 1e-9);
-  CHECK(a.preint.deltaQ().angularDistance(b.preint.deltaQ()) < 1e-9);
-  CHECK((a.preint.covariance() - b.preint.covariance()).cwiseAbs().maxCoeff() < 1e-9);
-  CHECK((a.preint.jacobian() - b.preint.jacobian()).cwiseAbs().maxCoeff() < 1e-9);
-  CHECK(a.preint.sumDt() == Approx(b.preint.sumDt()).margin(1e-12));
+  CHECK((a.preint.alpha - b.preint.alpha).norm() < 1e-9);
+  CHECK((a.preint.beta - b.preint.beta).norm() < 1e-9);
+  CHECK(a.preint.gamma.angularDistance(b.preint.gamma) < 1e-9);
+  CHECK((a.preint.covariance - b.preint.covariance).cwiseAbs().maxCoeff() < 1e-9);
+  CHECK((a.preint.jacobian - b.preint.jacobian).cwiseAbs().maxCoeff() < 1e-9);
+  CHECK(a.preint.sum_dt == Approx(b.preint.sum_dt).margin(1e-12));
   CHECK(a.num_raw_samples == b.num_raw_samples);
   CHECK(a.has_gap == b.has_gap);
   CHECK(a.max_gap_ns == b.max_gap_ns);

@@ -36,8 +36,8 @@ double maxDeltaError(const SmoothTrajectory& tr, const PreintegratedInterval& iv
   const Eigen::Vector3d alpha = a.R_wb.transpose() * (b.p_w - a.p_w - a.v_w * T - 0.5 * g * T * T);
   const Eigen::Vector3d beta = a.R_wb.transpose() * (b.v_w - a.v_w - g * T);
   const Eigen::Matrix3d gamma = a.R_wb.transpose() * b.R_wb;
-  return std::max({(iv.preint.deltaP() - alpha).norm(), (iv.preint.deltaV() - beta).norm(),
-                   so3::log(gamma.transpose() * iv.preint.deltaQ().toRotationMatrix()).norm()});
+  return std::max({(iv.preint.alpha - alpha).norm(), (iv.preint.beta - beta).norm(),
+                   so3::log(gamma.transpose() * iv.preint.gamma.toRotationMatrix()).norm()});
 }
 
 }  // namespace
@@ -57,9 +57,9 @@ TEST_CASE("one interval per consecutive frame pair, ends at the frame times, mat
   for (size_t k = 0; k < out.size(); ++k) {
     CHECK(out[k].t_begin_ns == f[k]);
     CHECK(out[k].t_end_ns == f[k + 1]);
-    CHECK(out[k].preint.tBeginNs() == f[k]);
-    CHECK(out[k].preint.tEndNs() == f[k + 1]);
-    CHECK(out[k].preint.sumDt() == Approx(0.05).epsilon(1e-9));
+    CHECK(out[k].preint.samples.front().t_ns == f[k]);
+    CHECK(out[k].preint.samples.back().t_ns == f[k + 1]);
+    CHECK(out[k].preint.sum_dt == Approx(0.05).epsilon(1e-9));
     CHECK(out[k].num_raw_samples == 10);
     CHECK_FALSE(out[k].has_gap);
     CHECK(out[k].max_gap_ns == 5'000'000);
@@ -93,8 +93,8 @@ TEST_CASE("the interleaving of IMU and frames does not change the intervals", "[
   REQUIRE(c.size() == a.size());
   for (size_t k = 0; k < a.size(); ++k) {
     CHECK(a[k].t_begin_ns == c[k].t_begin_ns);
-    CHECK((a[k].preint.deltaP() - c[k].preint.deltaP()).norm() == 0.0);
-    CHECK((a[k].preint.covariance() - c[k].preint.covariance()).norm() == 0.0);
+    CHECK((a[k].preint.alpha - c[k].preint.alpha).norm() == 0.0);
+    CHECK((a[k].preint.covariance - c[k].preint.covariance).norm() == 0.0);
   }
 }
 
@@ -122,7 +122,7 @@ TEST_CASE("out-of-order and duplicate IMU samples are rejected and counted", "[i
   CHECK(dirty.stats().imu_rejected_out_of_order == 3);
   CHECK(clean.stats().imu_rejected_out_of_order == 0);
   REQUIRE(a.size() == c.size());
-  for (size_t k = 0; k < a.size(); ++k) CHECK((a[k].preint.deltaV() - c[k].preint.deltaV()).norm() == 0.0);
+  for (size_t k = 0; k < a.size(); ++k) CHECK((a[k].preint.beta - c[k].preint.beta).norm() == 0.0);
   // Frames going backwards are rejected too.
   dirty.addFrame(f[3]);
   CHECK(dirty.stats().frames_rejected_out_of_order == 1);

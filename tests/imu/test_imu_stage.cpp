@@ -55,8 +55,8 @@ TEST_CASE("ImuStage emits one interval per frame pair and applies new biases to 
   // Intervals are built when the IMU passes their end; those completed after setBiases use the new ones.
   int with_new_biases = 0;
   for (const auto& iv : out) {
-    if (iv.preint.linearizedBa() == ba && iv.preint.linearizedBg() == bg) ++with_new_biases;
-    else CHECK(iv.preint.linearizedBa().isZero());
+    if (iv.preint.ba == ba && iv.preint.bg == bg) ++with_new_biases;
+    else CHECK(iv.preint.ba.isZero());
   }
   CHECK(with_new_biases >= 3);
   CHECK(with_new_biases < frames - 1);

@@ -5,7 +5,7 @@
 #include <variant>
 
 #include "messages/tracked_frame.hpp"
-#include "stages/imu/preintegrated_interval.hpp"
+#include "messages/preintegrated_interval.hpp"
 
 namespace dynavins::estimator {
 
