@@ -6,7 +6,7 @@ TSAN_BUILD ?= build-tsan
 CMAKE_GEN  := -G Ninja
 CTEST_J    ?= 2
 
-.PHONY: all deps build demo bench bench-quick test test-unit test-tsan clean
+.PHONY: all deps build demo bench bench-quick test test-unit test-tsan lint format-check clean
 
 all: build
 
@@ -55,6 +55,21 @@ test-tsan: deps
 	cmake --build $(TSAN_BUILD)
 	TSAN_OPTIONS="halt_on_error=1 second_deadlock_stack=1 suppressions=$(CURDIR)/tests/tsan.supp" \
 	  ctest --test-dir $(TSAN_BUILD) --output-on-failure -j $(CTEST_J) -LE heavy
+
+# Naming convention (CONTRIBUTING.md): clang-tidy with only readability-identifier-naming (.clang-tidy) over
+# the project's own sources in $(BUILD)/compile_commands.json (generated code under $(BUILD)/ and
+# third_party/ left out); fails on any violation. Not yet enforced in CI: the tree still has violations.
+LINT_DIRS := stages|pipeline|io|eval|sim|bin|bench|messages|tests
+lint: build
+	run-clang-tidy -quiet -p $(BUILD) -j $(CTEST_J) \
+	  -header-filter='^$(CURDIR)/($(LINT_DIRS))/' '^$(CURDIR)/($(LINT_DIRS))/.*\.cpp$$'
+
+# clang-format (.clang-format) on the C++ lines changed against main only (git clang-format): the tree is
+# not reformatted wholesale (about 3% of its lines would move). Prints the changes it wants; fails if any.
+format-check:
+	@out=$$(git clang-format --diff --extensions cpp,hpp main); \
+	  if echo "$$out" | grep -q '^diff'; then echo "$$out"; exit 1; fi; \
+	  echo "format-check: lines changed against main are formatted"
 
 clean:
 	rm -rf $(BUILD) $(TSAN_BUILD)

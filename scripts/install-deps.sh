@@ -20,6 +20,8 @@ PACKAGES=(
   util-linux iproute2
   # ROS 1 bag import (rosbag_storage + message headers, no ROS master)
   librosbag-storage-dev libsensor-msgs-dev libnav-msgs-dev
+  # naming and format checks (make lint, make format-check)
+  clang-tidy clang-format
   # benchmark report and figures (bench/report/make_report.py, run with /usr/bin/python3)
   python3 python3-matplotlib python3-numpy
 )
