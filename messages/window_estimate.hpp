@@ -12,13 +12,13 @@ namespace dynavins::estimator {
 
 /// Cost and shape of one window solve (all alternations together).
 struct SolveStats {
-  double total_ms = 0;        ///< the whole process() call
-  double ba_ms = 0;           ///< Ceres solves + weight steps (what the paper's "BA time" measures)
-  double weight_ms = 0;       ///< closed-form weight steps only
+  double total_ms = 0;   ///< the whole process() call
+  double ba_ms = 0;      ///< Ceres solves + weight steps (what the paper's "BA time" measures)
+  double weight_ms = 0;  ///< closed-form weight steps only
   double marginalization_ms = 0;
-  int alternations = 0;       ///< weight step + state solve pairs (1 for huber)
-  int ceres_iterations = 0;   ///< summed over alternations
-  int features_in_window = 0; ///< features with a depth estimate used in the solve
+  int alternations = 0;        ///< weight step + state solve pairs (1 for huber)
+  int ceres_iterations = 0;    ///< summed over alternations
+  int features_in_window = 0;  ///< features with a depth estimate used in the solve
 };
 
 enum class EstimatorStatus : int8_t {
@@ -29,14 +29,14 @@ enum class EstimatorStatus : int8_t {
 
 struct WindowEstimate {
   int64_t t_ns = 0;
-  int64_t seq = 0;          ///< the tracked frame's seq
+  int64_t seq = 0;  ///< the tracked frame's seq
   EstimatorStatus status = EstimatorStatus::Initializing;
-  NavState state;           ///< body in world at t_ns; valid when status == Tracking
-  bool keyframe = false;    ///< the previous newest frame was kept as a keyframe (VINS' MARGIN_OLD)
-  bool standstill = false;  ///< found at rest: its velocity was held at zero (standstill_detector.hpp)
+  NavState state;               ///< body in world at t_ns; valid when status == Tracking
+  bool keyframe = false;        ///< the previous newest frame was kept as a keyframe (VINS' MARGIN_OLD)
+  bool standstill = false;      ///< found at rest: its velocity was held at zero (standstill_detector.hpp)
   WeightedFeatureSet features;  ///< window features, weights after this solve (Tracking only)
   SolveStats solve;
-  std::string event;        ///< "initialized", "reset: <reason>", or empty
+  std::string event;  ///< "initialized", "reset: <reason>", or empty
 };
 
 }  // namespace dynavins::estimator
