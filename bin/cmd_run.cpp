@@ -1,5 +1,5 @@
 // `dynavins run --config FILE.yaml (--euroc DIR | --log FILE | --rosbag FILE) [--rate R] [--out DIR]
-//  [--ba huber|dynavins] [--mono] [--gyro-prediction] [--set key=value ...]`: the whole
+//  [--ba huber|dynavins] [--mono] [--gyro-prediction] [--set key=value ...] [--lcm-url URL [--channel key=NAME]]`: the whole
 // visual-inertial pipeline on a recording; writes odometry, weighted features, events and summary.json into --out.
 #include <cstdio>
 #include <filesystem>
@@ -34,6 +34,8 @@ struct RunCommandOptions {
   std::vector<std::string> set;
   double imu_rate_hz = 200.0;
   bool gyro_prediction = false;
+  std::string lcm_url;
+  std::vector<std::string> channels;
 };
 
 std::string inputName(const SensorInput& in) {
@@ -64,7 +66,9 @@ void run(const RunCommandOptions& o) {
   opt.rate = o.rate;
   opt.imu_rate_hz = o.imu_rate_hz;
   opt.gyro_prediction = o.gyro_prediction;
+  opt.lcm_url = o.lcm_url;
   try {
+    for (const std::string& c : o.channels) opt.channels.set(c);
     pipeline::checkVioOptions(opt);
   } catch (const std::invalid_argument& e) {
     throw CommandError(e.what(), 2);
@@ -94,7 +98,7 @@ void run(const RunCommandOptions& o) {
   pipeline::VioRunResult r;
   try {
     r = pipeline::runVio(*source, opt, sinks);
-  } catch (const std::invalid_argument& e) {
+  } catch (const std::exception& e) {  // options that cannot run, an LCM URL that does not open
     throw CommandError(e.what(), 2);
   }
   if (!r.report.ok) {
@@ -131,6 +135,13 @@ void run(const RunCommandOptions& o) {
                 outputs->ate().sim3_m, outputs->ate().matched);
   else if (!outputs->ate().error.empty())
     std::printf("ATE         not computed: %s\n", outputs->ate().error.c_str());
+  if (r.publisher)
+    std::printf("lcm         %s: %lld IMU-rate poses, %lld window poses, %lld feature sets, %lld dropped, %lld failed; "
+                "IMU pose latency mean %.3f ms, p99 %.3f ms\n",
+                r.publisher->url.c_str(), static_cast<long long>(r.publisher->imu_poses),
+                static_cast<long long>(r.publisher->window_poses), static_cast<long long>(r.publisher->feature_sets),
+                static_cast<long long>(r.publish_dropped), static_cast<long long>(r.publisher->failed),
+                r.publisher->imu_pose_latency.mean_ms, r.publisher->imu_pose_latency_p99_ms);
   std::printf("outputs     %s\n", out_dir.c_str());
 }
 
@@ -153,6 +164,11 @@ void add_run_command(CLI::App& app) {
                 "Seed the tracker's KLT with the gyro-integrated rotation (bias from the estimator; the run then "
                 "depends on thread timing and is not bit-repeatable)");
   cmd->add_option("--set", o->set, "Override a yaml option: --set key=value (repeatable)");
+  cmd->add_option("--lcm-url", o->lcm_url,
+                  "Publish poses, weighted features, status and stats on LCM while running, e.g. "
+                  "udpm://239.255.76.67:7667?ttl=0 (default: publish nothing)");
+  cmd->add_option("--channel", o->channels,
+                  "Rename an output channel: --channel key=NAME (keys: pose_imu, pose, features, status, stats)");
   cmd->add_option("--imu-rate", o->imu_rate_hz, "Nominal IMU rate [Hz], for IMU gap detection")
       ->check(CLI::Range(1.0, 100000.0))
       ->capture_default_str();

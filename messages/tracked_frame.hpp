@@ -44,6 +44,7 @@ struct TrackedFrame {
   int64_t seq = 0;
   std::vector<TrackedFeature> features;
   TrackerStats stats;
+  int64_t received_ns = 0;  ///< steady clock when the tracker took the frame (latency accounting only)
 };
 
 }  // namespace dynavins

@@ -37,6 +37,7 @@ struct WindowEstimate {
   WeightedFeatureSet features;  ///< window features, weights after this solve (Tracking only)
   SolveStats solve;
   std::string event;  ///< "initialized", "reset: <reason>", or empty
+  int64_t received_ns = 0;  ///< the frame's TrackedFrame::received_ns (latency accounting only)
 };
 
 }  // namespace dynavins::estimator

@@ -14,6 +14,7 @@ inline constexpr const char* kPose = "DYNAVINS_POSE";             // pose_t, win
 inline constexpr const char* kFeatures = "DYNAVINS_FEATURES";     // weighted_feature_set_t
 inline constexpr const char* kLoops = "DYNAVINS_LOOPS";           // loop_hypotheses_t
 inline constexpr const char* kPath = "DYNAVINS_PATH";             // path_t
-inline constexpr const char* kStats = "DYNAVINS_STATS";           // pipeline_stats_t
+inline constexpr const char* kStats = "DYNAVINS_STATS";           // pipeline_stats_t, once a second
+inline constexpr const char* kStatus = "DYNAVINS_STATUS";         // status_t, on change and once a second
 
 }  // namespace dynavins::channels

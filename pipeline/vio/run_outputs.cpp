@@ -258,6 +258,17 @@ std::string summaryJson(const VioRunResult& run, const RunDescription& what, con
   } else if (!ate.error.empty()) {
     j << "  \"ate_error\": " << json_string(ate.error) << ",\n";
   }
+  if (run.publisher) {
+    const PublisherStats& p = *run.publisher;
+    j << "  \"lcm\": {\"url\": " << json_string(p.url) << ", \"imu_poses\": " << p.imu_poses
+      << ", \"window_poses\": " << p.window_poses << ", \"feature_sets\": " << p.feature_sets
+      << ", \"status\": " << p.status << ", \"stats\": " << p.stats << ", \"failed\": " << p.failed
+      << ", \"dropped\": " << run.publish_dropped << ",\n           \"imu_pose_latency_ms\": {\"mean\": "
+      << num(p.imu_pose_latency.mean_ms) << ", \"p99\": " << num(p.imu_pose_latency_p99_ms)
+      << ", \"max\": " << num(p.imu_pose_latency.max_ms) << "}, \"window_pose_latency_ms\": {\"mean\": "
+      << num(p.window_pose_latency.mean_ms) << ", \"p99\": " << num(p.window_pose_latency_p99_ms)
+      << ", \"max\": " << num(p.window_pose_latency.max_ms) << "}},\n";
+  }
   j << "  \"pipeline\": " << report_to_json(run.report) << "\n";
   j << "}";
   return j.str();

@@ -1,12 +1,14 @@
 #include "pipeline/vio/vio_pipeline.hpp"
 
 #include <chrono>
+#include <memory>
 #include <optional>
 #include <stdexcept>
 #include <utility>
 
 #include <spdlog/spdlog.h>
 
+#include "pipeline/clock.hpp"
 #include "pipeline/emit.hpp"
 #include "pipeline/interrupt.hpp"
 #include "pipeline/vio/frame_imu_attacher.hpp"
@@ -71,7 +73,8 @@ void checkVioOptions(const VioRunOptions& o) {
   if (o.mode.stereo && (o.estimator.num_of_cam < 2 || o.estimator.cameras.size() < 2))
     throw std::invalid_argument("stereo needs num_of_cam: 2 in the config; use --mono for one camera");
   if (o.rate < 0) throw std::invalid_argument("rate must be >= 0");
-  if (o.frame_queue == 0 || o.imu_queue == 0 || o.estimator_queue == 0 || o.output_queue == 0)
+  if (o.frame_queue == 0 || o.imu_queue == 0 || o.estimator_queue == 0 || o.output_queue == 0 ||
+      o.publish_queue == 0)
     throw std::invalid_argument("queue capacities must be positive");
 }
 
@@ -90,6 +93,26 @@ VioRunResult runVio(io::SensorSource& source, const VioRunOptions& opt, const Vi
   auto& estimates = p.add_queue<WindowEstimate>("estimates", opt.output_queue, Backpressure::Block);
   auto from_tracker = est_in.make_producer();
   auto from_imu = est_in.make_producer();
+
+  // The publisher: IMU-rate poses from the IMU thread, the rest from the writer's; it never blocks them.
+  std::unique_ptr<LcmPublisher> publisher;
+  FanInQueue<PublishItem>* publish_q = nullptr;
+  std::unique_ptr<FanInQueue<PublishItem>::Producer> imu_pub, writer_pub;
+  if (!opt.lcm_url.empty()) {
+    const int64_t t0 = steady_now_ns();
+    publisher = std::make_unique<LcmPublisher>(opt.lcm_url, opt.channels, [&p, t0] {
+      RunReport r;
+      r.stages = p.stage_stats();
+      r.queues = p.queue_stats();
+      r.wall_s = static_cast<double>(steady_now_ns() - t0) / 1e9;
+      return r;
+    });
+    publish_q = &p.add_fan_in<PublishItem>("publish", opt.publish_queue, Backpressure::DropNewest);
+    imu_pub = publish_q->make_producer();
+    writer_pub = publish_q->make_producer();
+    st.imu.on_imu_pose = [&](const PoseEstimate& pose, int64_t origin) { imu_pub->push(PublishItem{origin, pose}); };
+    st.writer.publish = [&](PublishItem item) { writer_pub->push(std::move(item)); };
+  }
 
   p.add_source(
       "replay",
@@ -118,11 +141,22 @@ VioRunResult runVio(io::SensorSource& source, const VioRunOptions& opt, const Vi
         imu_in.close();
       });
   p.add_stage("tracker", st.tracker, frames, into(*from_tracker), [&] { from_tracker->close(); });
-  p.add_stage("imu", st.imu, imu_in, into(*from_imu), [&] { from_imu->close(); });
+  p.add_stage("imu", st.imu, imu_in, into(*from_imu), [&] {
+    from_imu->close();
+    if (imu_pub) imu_pub->close();
+  });
   p.add_stage("estimator", st.estimator, est_in, into(estimates), [&] { estimates.close(); });
-  p.add_stage("writer", st.writer, estimates, NoOutput{}, {});
+  p.add_stage("writer", st.writer, estimates, NoOutput{}, [&] {
+    if (writer_pub) writer_pub->close();
+  });
+  if (publisher) p.add_stage("publisher", *publisher, *publish_q, NoOutput{}, {});
 
   result.report = p.run();
+  if (publisher) {
+    result.publisher = publisher->stats();
+    for (const auto& q : result.report.queues)
+      if (q.name == "publish") result.publish_dropped = static_cast<int64_t>(q.dropped);
+  }
   countFrames(result);
   st.collect(result);
   return result;
@@ -132,6 +166,7 @@ VioRunResult runVioSequential(io::SensorSource& source, const VioRunOptions& opt
                               const StopFlag* external_stop) {
   checkVioOptions(opt);
   if (opt.rate != 0) throw std::invalid_argument("the sequential run replays as fast as possible: rate must be 0");
+  if (!opt.lcm_url.empty()) throw std::invalid_argument("the sequential run does not publish: use runVio for lcm_url");
   VioRunResult result;
   result.source = source.describe();
   VioStages st(opt, sinks.tracked, sinks.estimate);

@@ -4,8 +4,10 @@
 //   replay ─┬─ stereo frames + their gyro samples (SPSC, 8) ──▶ tracker ── tracked frames ──┐
 //           │                                                      ▲                        ▼ (fan-in)
 //           └─ IMU + frame times (SPSC, 4000) ──▶ imu ── intervals ┼─────────────────▶ estimator ── estimates ──▶ writer
-//                                                  ▲               └─ gyro bias ───────────┤ (LatestValue)
-//                                                  └─ latest NavState ─────────────────────┘ (LatestValue: biases)
+//                                                  ▲ │             └─ gyro bias ───────────┤ (LatestValue)   │
+//                                                  └─┼─ latest NavState ───────────────────┘ (LatestValue)   │
+//                                                    └── IMU-rate pose ──▶ publisher (LCM) ◀── window pose, ─┘
+//                                                        (fan-in, 4096, drops when full)      features, status
 //
 // Gyro prediction (on by default): the replay packs each frame with the IMU samples of its interval
 // (FrameImuAttacher), the tracker integrates them (GyroRotationPredictor, minus the estimator's newest gyro
@@ -24,11 +26,13 @@
 #include <cstddef>
 #include <cstdint>
 #include <functional>
+#include <optional>
 #include <string>
 #include <vector>
 
 #include "io/sensor_source.hpp"
 #include "messages/tracked_frame.hpp"
+#include "pipeline/lcm_publisher.hpp"
 #include "pipeline/pipeline.hpp"
 #include "pipeline/replay.hpp"
 #include "pipeline/stop_flag.hpp"
@@ -55,6 +59,10 @@ struct VioRunOptions {
   /// Seed the tracker's KLT with the gyro-integrated rotation (off by default: the gyro bias comes from
   /// the estimator thread, so a run then depends on thread timing and is no longer bit-repeatable).
   bool gyro_prediction = false;
+  /// Publish on LCM while running (lcm_publisher.hpp); empty = publish nothing. Threaded run only.
+  std::string lcm_url;
+  PublisherChannels channels;
+  std::size_t publish_queue = 4096;  ///< items waiting for the publisher; a full queue drops (counted)
 };
 
 /// Where the results go. Threaded: `estimate` is called on the writer thread, `tracked` on the tracker
@@ -93,6 +101,8 @@ struct VioRunResult {
   ImuIntervalBuilderStats imu_builder;
   FrameImuPairerStats pairer;
   std::vector<GroundTruthState> ground_truth;  ///< the source's ground truth, in time order
+  std::optional<PublisherStats> publisher;     ///< what was published (with lcm_url)
+  int64_t publish_dropped = 0;                 ///< items the full publish queue dropped
   bool interrupted() const { return report.interrupted || replay.stopped; }
 };
 

@@ -8,6 +8,7 @@
 
 #include <spdlog/spdlog.h>
 
+#include "pipeline/clock.hpp"
 #include "pipeline/vio/vio_pipeline.hpp"
 
 namespace dynavins::pipeline {
@@ -17,6 +18,7 @@ TrackerStage::TrackerStage(StereoTracker t, bool mono_, std::optional<GyroRotati
     : tracker(std::move(t)), mono(mono_), gyro(std::move(g)), gyro_bias(b), on_tracked(std::move(cb)) {}
 
 TrackedFrame TrackerStage::process(TrackerInput in) {
+  const int64_t received_ns = steady_now_ns();
   if (mono) in.frame.right = cv::Mat();
   std::optional<Eigen::Matrix3d> R_prev_curr;
   if (gyro) {
@@ -26,6 +28,7 @@ TrackedFrame TrackerStage::process(TrackerInput in) {
   }
   prev_t_ns = in.frame.t_ns;
   TrackedFrame out = tracker.process(in.frame, R_prev_curr);
+  out.received_ns = received_ns;
   features_predicted += out.stats.predicted;
   features_tracked += out.stats.tracked;
   features_lost_flow += out.stats.lost_flow;
@@ -35,7 +38,18 @@ TrackedFrame TrackerStage::process(TrackerInput in) {
 }
 
 std::vector<PreintegratedInterval> ImuFeedbackStage::process(ImuStageInput in) {
-  if (const auto s = latest.read()) stage.setBiases(s->bias_acc, s->bias_gyr);
+  const int64_t origin_ns = on_imu_pose ? steady_now_ns() : 0;
+  const auto s = latest.read();
+  if (s) stage.setBiases(s->bias_acc, s->bias_gyr);
+  if (on_imu_pose) {
+    if (s && s->t_ns != propagated_from_ns) {
+      propagator.reset(*s);
+      propagated_from_ns = s->t_ns;
+    }
+    const auto* sample = std::get_if<ImuSample>(&in);
+    if (sample && s && sample->t_ns - propagated_from_ns <= max_propagation_ns)
+      if (const auto p = propagator.addImu(*sample)) on_imu_pose(PoseEstimate{PoseSource::ImuRate, *p}, origin_ns);
+  }
   return stage.process(in);
 }
 
@@ -50,6 +64,7 @@ std::vector<estimator::WindowEstimate> EstimatorStage::process(estimator::Estima
   out.reserve(ready.size());
   for (FrameWithImu& f : ready) {
     out.push_back(estimator.process(f.frame, f.imu ? &*f.imu : nullptr));
+    out.back().received_ns = f.frame.received_ns;
     const estimator::WindowEstimate& e = out.back();
     if (e.status == estimator::EstimatorStatus::Tracking) {
       ++tracking;
@@ -61,6 +76,20 @@ std::vector<estimator::WindowEstimate> EstimatorStage::process(estimator::Estima
     if (!e.event.empty()) spdlog::info("estimator: t = {} ns: {}", e.t_ns, e.event);
   }
   return out;
+}
+
+void WriterStage::process(estimator::WindowEstimate e) {
+  if (sink) sink(e);
+  ++frames;
+  resets += e.status == estimator::EstimatorStatus::Reset;
+  if (!publish) return;
+  if (e.status != last_status || !e.event.empty()) {
+    last_status = e.status;
+    publish(PublishItem{0, StatusUpdate{e.t_ns, e.status, e.event, frames, resets}});
+  }
+  if (e.status != estimator::EstimatorStatus::Tracking) return;
+  publish(PublishItem{e.received_ns, PoseEstimate{PoseSource::Window, e.state}});
+  publish(PublishItem{0, std::move(e.features)});
 }
 
 namespace {
@@ -99,9 +128,10 @@ VioStages::VioStages(const VioRunOptions& o, std::function<void(const TrackedFra
       tracker(StereoTracker(TrackerOptions::from(o.estimator), o.estimator.cameras.at(0),
                             o.mode.stereo ? o.estimator.cameras.at(1) : nullptr),
               !o.mode.stereo, gyroPredictor(o, predict), gyro_bias, std::move(on_tracked)),
-      imu{ImuStage(ImuStageOptions::from(o.estimator, o.imu_rate_hz, o.imu_noise)), latest},
+      imu{ImuStage(ImuStageOptions::from(o.estimator, o.imu_rate_hz, o.imu_noise)), latest, {},
+          ImuPropagator(ImuPropagatorOptions{o.estimator.g_norm})},
       estimator{FrameImuPairer{}, estimator::SlidingWindowEstimator(estimatorOptions(o), o.mode), latest, gyro_bias},
-      writer{std::move(on_estimate)} {}
+      writer{std::move(on_estimate), {}, 0, 0, std::nullopt} {}
 
 void VioStages::collect(VioRunResult& r) const {
   r.gyro_prediction = predict;

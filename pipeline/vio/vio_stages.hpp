@@ -11,6 +11,7 @@
 // Feedback: the estimator publishes its newest NavState to the IMU stage and its gyro bias to the tracker
 // through LatestValue snapshots (never waited on).
 
+#include <climits>
 #include <cstdint>
 #include <functional>
 #include <optional>
@@ -20,11 +21,13 @@
 
 #include "messages/tracked_frame.hpp"
 #include "pipeline/latest_value.hpp"
+#include "pipeline/publish_item.hpp"
 #include "pipeline/vio/frame_imu_attacher.hpp"
 #include "messages/estimator_input.hpp"
 #include "stages/estimator/sliding_window_estimator.hpp"
 #include "messages/window_estimate.hpp"
 #include "stages/imu/frame_imu_pairer.hpp"
+#include "stages/imu/imu_propagator.hpp"
 #include "stages/imu/imu_stage.hpp"
 #include "stages/tracker/gyro_rotation_predictor.hpp"
 #include "stages/tracker/stereo_tracker.hpp"
@@ -59,11 +62,19 @@ struct TrackerStage {
 /// IMU stage: before each input, linearise at the estimator's newest biases (read without waiting). The
 /// estimator re-propagates an interval whose biases differ from its own, so the estimate does not depend
 /// on which biases were current here.
+/// With `on_imu_pose`, it also propagates the estimator's newest state through every IMU sample (the
+/// IMU-rate pose, VINS-Fusion's fastPredict), but never further than `max_propagation_ns` past that
+/// state: when the estimator stops tracking (reset, lost), the IMU-rate pose stops too instead of
+/// dead-reckoning on.
 struct ImuFeedbackStage {
   std::vector<PreintegratedInterval> process(ImuStageInput in);
 
   ImuStage stage;
   LatestValue<NavState>& latest;
+  std::function<void(const PoseEstimate&, int64_t origin_ns)> on_imu_pose;  ///< may be empty
+  ImuPropagator propagator;
+  int64_t max_propagation_ns = 500'000'000;
+  int64_t propagated_from_ns = INT64_MIN;  ///< t_ns of the state the propagator was last reset to
 };
 
 /// Estimator: pairs frames with their IMU intervals, runs the window BA, publishes the newest state.
@@ -78,12 +89,15 @@ struct EstimatorStage {
   int64_t tracking = 0, resets = 0;
 };
 
-/// Writer: hands each estimate to the run's sink.
+/// Writer: hands each estimate to the run's sink and, with `publish`, its window pose, weighted features
+/// and (when it changes) the estimator's status to the publisher.
 struct WriterStage {
-  void process(estimator::WindowEstimate e) {
-    if (sink) sink(e);
-  }
+  void process(estimator::WindowEstimate e);
+
   std::function<void(const estimator::WindowEstimate&)> sink;
+  std::function<void(PublishItem)> publish;  ///< may be empty
+  int64_t frames = 0, resets = 0;
+  std::optional<estimator::EstimatorStatus> last_status;
 };
 
 /// Every stage of one run and the feedback snapshots between them, built from the run's options.
