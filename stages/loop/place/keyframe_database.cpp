@@ -17,9 +17,8 @@ void KeyframeDatabase::add(int64_t keyframe_id, int64_t t_ns, const BowVector& b
 
 std::vector<PlaceCandidate> KeyframeDatabase::query(const BowVector& bow, const DatabaseQueryOptions& opts) const {
   const std::size_t n = entries_.size();
-  const std::size_t allowed_end = opts.exclude_recent > 0
-                                      ? (n > static_cast<std::size_t>(opts.exclude_recent) ? n - opts.exclude_recent : 0)
-                                      : n;
+  const std::size_t allowed_end =
+      opts.exclude_recent > 0 ? (n > static_cast<std::size_t>(opts.exclude_recent) ? n - opts.exclude_recent : 0) : n;
   std::vector<double> score(allowed_end, 0.0);
   std::vector<bool> touched(allowed_end, false);
   for (const BowEntry& q : bow) {

@@ -14,10 +14,10 @@
 namespace dynavins::loop {
 
 struct DatabaseQueryOptions {
-  int max_results = 3;          // a few candidates per query keyframe, best first
-  double min_score = 0.0;       // candidates must score above this (L1 score, [0, 1])
+  int max_results = 3;                                     // a few candidates per query keyframe, best first
+  double min_score = 0.0;                                  // candidates must score above this (L1 score, [0, 1])
   int64_t max_t_ns = std::numeric_limits<int64_t>::max();  // only keyframes with t_ns <= this
-  int exclude_recent = 0;       // skip the most recently added N keyframes (the query's own neighbourhood)
+  int exclude_recent = 0;  // skip the most recently added N keyframes (the query's own neighbourhood)
 };
 
 struct PlaceCandidate {

@@ -56,8 +56,9 @@ KeyframeDescriptors compute_keyframe_descriptors(const Keyframe& kf, const Descr
   std::vector<cv::KeyPoint> keypoints;
   keypoints.reserve(candidates.size());
   for (std::size_t i = 0; i < candidates.size(); ++i)
-    keypoints.emplace_back(cv::Point2f(static_cast<float>(candidates[i].px.x()), static_cast<float>(candidates[i].px.y())),
-                           31.f, 0.f, 0.f, 0, static_cast<int>(i));
+    keypoints.emplace_back(
+        cv::Point2f(static_cast<float>(candidates[i].px.x()), static_cast<float>(candidates[i].px.y())), 31.f, 0.f, 0.f,
+        0, static_cast<int>(i));
   cv::Mat desc;
   if (!keypoints.empty()) {
     cv::Ptr<cv::ORB> orb = cv::ORB::create(opts.max_points, 1.2f, 1, 31, 0, 2, cv::ORB::HARRIS_SCORE, 31);

@@ -18,10 +18,10 @@
 namespace dynavins::loop {
 
 struct DescriptorOptions {
-  int max_points = 400;         // tracked features + extra corners, at most
-  double corner_quality = 0.01;  // Shi-Tomasi threshold, fraction of the strongest corner
+  int max_points = 400;                  // tracked features + extra corners, at most
+  double corner_quality = 0.01;          // Shi-Tomasi threshold, fraction of the strongest corner
   double corner_min_distance_px = 10.0;  // extra corners keep this far from each other and from tracked points
-  int border_px = 31;           // ORB's edge threshold: points closer to the border get no descriptor (dropped)
+  int border_px = 31;  // ORB's edge threshold: points closer to the border get no descriptor (dropped)
 };
 
 /// A keyframe as the database keeps it. Row i of `descriptors` (CV_8UC1, N x 32) describes points[i].

@@ -12,11 +12,16 @@ namespace dynavins::loop {
 
 const char* to_string(LoopRejection r) {
   switch (r) {
-    case LoopRejection::None: return "none";
-    case LoopRejection::TooFewMatches: return "too few descriptor matches";
-    case LoopRejection::PnpFailed: return "PnP RANSAC failed";
-    case LoopRejection::TooFewInliers: return "too few PnP inliers";
-    case LoopRejection::Implausible: return "implausible relative pose";
+    case LoopRejection::None:
+      return "none";
+    case LoopRejection::TooFewMatches:
+      return "too few descriptor matches";
+    case LoopRejection::PnpFailed:
+      return "PnP RANSAC failed";
+    case LoopRejection::TooFewInliers:
+      return "too few PnP inliers";
+    case LoopRejection::Implausible:
+      return "implausible relative pose";
   }
   return "?";
 }
@@ -86,7 +91,8 @@ LoopVerification LoopVerifier::verify(const KeyframeDescriptors& query, const Ke
     return v;
   }
   const double angle_deg = Eigen::AngleAxisd(v.loop.q_mq).angle() * 180.0 / M_PI;
-  if (!v.loop.p_mq.allFinite() || v.loop.p_mq.norm() > opts_.max_translation_m || !(angle_deg <= opts_.max_rotation_deg)) {
+  if (!v.loop.p_mq.allFinite() || v.loop.p_mq.norm() > opts_.max_translation_m ||
+      !(angle_deg <= opts_.max_rotation_deg)) {
     v.rejection = LoopRejection::Implausible;
     return v;
   }

@@ -14,13 +14,13 @@ namespace dynavins::loop {
 
 struct LoopVerifierOptions {
   DescriptorMatchOptions matching;
-  double focal_px = 460.0;           // converts the pixel threshold to normalised units (EuRoC cam0 ~458 px)
-  double reprojection_px = 3.0;      // RANSAC inlier threshold [px]
+  double focal_px = 460.0;       // converts the pixel threshold to normalised units (EuRoC cam0 ~458 px)
+  double reprojection_px = 3.0;  // RANSAC inlier threshold [px]
   int ransac_iterations = 200;
   double ransac_confidence = 0.99;
-  int min_inliers = 15;              // DESIGN.md §3
-  double max_translation_m = 10.0;   // |p_mq| above this is implausible for a revisit seen by the same camera
-  double max_rotation_deg = 45.0;    // rotation angle of q_mq above this is implausible (VINS-Mono: 30 deg yaw)
+  int min_inliers = 15;             // DESIGN.md §3
+  double max_translation_m = 10.0;  // |p_mq| above this is implausible for a revisit seen by the same camera
+  double max_rotation_deg = 45.0;   // rotation angle of q_mq above this is implausible (VINS-Mono: 30 deg yaw)
 };
 
 enum class LoopRejection { None, TooFewMatches, PnpFailed, TooFewInliers, Implausible };
@@ -30,8 +30,8 @@ const char* to_string(LoopRejection r);
 struct LoopVerification {
   bool accepted = false;
   LoopRejection rejection = LoopRejection::None;
-  int matches = 0;  // putative descriptor matches
-  int inliers = 0;  // PnP RANSAC inliers (also loop.inliers when accepted)
+  int matches = 0;    // putative descriptor matches
+  int inliers = 0;    // PnP RANSAC inliers (also loop.inliers when accepted)
   VerifiedLoop loop;  // query_t_ns / match_t_ns always set; the pose when PnP succeeded
 };
 

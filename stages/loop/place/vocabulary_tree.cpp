@@ -173,7 +173,8 @@ class Reader {
 }  // namespace
 
 VocabularyTree VocabularyTree::build(const std::vector<cv::Mat>& descriptors, const VocabularyOptions& opts) {
-  if (opts.branching < 2 || opts.depth < 1) throw std::invalid_argument("VocabularyTree::build: branching >= 2, depth >= 1");
+  if (opts.branching < 2 || opts.depth < 1)
+    throw std::invalid_argument("VocabularyTree::build: branching >= 2, depth >= 1");
   std::vector<Descriptor> all;
   for (const cv::Mat& d : descriptors) {
     check_descriptors(d, "VocabularyTree::build");

@@ -18,10 +18,10 @@
 namespace dynavins::loop {
 
 struct VocabularyOptions {
-  int branching = 10;         // k of each k-medians split
-  int depth = 5;              // levels below the root: up to branching^depth words (10^5 by default)
-  int max_iterations = 10;    // k-medians iterations per split (stops earlier when assignments settle)
-  uint64_t seed = 42;         // k-means++ seeding; the same seed and data give the same tree
+  int branching = 10;       // k of each k-medians split
+  int depth = 5;            // levels below the root: up to branching^depth words (10^5 by default)
+  int max_iterations = 10;  // k-medians iterations per split (stops earlier when assignments settle)
+  uint64_t seed = 42;       // k-means++ seeding; the same seed and data give the same tree
 };
 
 class VocabularyTree {
@@ -34,8 +34,8 @@ class VocabularyTree {
     int32_t word = -1;
     float weight = 0.f;  // idf = ln(N / n_i), N training images, n_i of them containing the word
     bool operator==(const Node& o) const {
-      return centre == o.centre && first_child == o.first_child && num_children == o.num_children &&
-             word == o.word && weight == o.weight;
+      return centre == o.centre && first_child == o.first_child && num_children == o.num_children && word == o.word &&
+             weight == o.weight;
     }
   };
 

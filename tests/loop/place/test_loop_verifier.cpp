@@ -31,8 +31,8 @@ struct Scene {
   int correct = 0;  // correspondences with the right query position
 };
 
-/// `shared` points seen by both keyframes (round(wrong * shared) of them, evenly spread, at a random query position, i.e.
-/// wrong correspondences), plus `extra` unrelated points in each; pixel noise `noise_px` at 460 px focal.
+/// `shared` points seen by both keyframes (round(wrong * shared) of them, evenly spread, at a random query position,
+/// i.e. wrong correspondences), plus `extra` unrelated points in each; pixel noise `noise_px` at 460 px focal.
 Scene make_scene(int shared, double wrong, int extra, double noise_px, uint32_t seed) {
   std::mt19937 rng(seed);
   std::uniform_real_distribution<double> u(-1.0, 1.0), depth(2.0, 8.0);

@@ -29,8 +29,8 @@ struct EurocCamera {
 };
 
 EurocCamera load_camera(int n) {
-  const std::string path = std::string(DYNAVINS_SHARED_DIR) + "/data/euroc_v1_01_micro/mav0/cam" + std::to_string(n) +
-                           "/sensor.yaml";
+  const std::string path =
+      std::string(DYNAVINS_SHARED_DIR) + "/data/euroc_v1_01_micro/mav0/cam" + std::to_string(n) + "/sensor.yaml";
   cv::FileStorage fs(path, cv::FileStorage::READ);
   REQUIRE(fs.isOpened());
   std::vector<double> T, in, d;

@@ -121,10 +121,11 @@ TEST_CASE("vocabulary tree: a truncated or foreign file is an error naming the f
   const std::string good = read_all(path);
 
   write_all(path, good.substr(0, good.size() - 20));
-  CHECK_THROWS_WITH(VocabularyTree::load(path), Catch::Contains(path) && Catch::Contains("truncated") &&
-                                                    Catch::Contains("offset"));
+  CHECK_THROWS_WITH(VocabularyTree::load(path),
+                    Catch::Contains(path) && Catch::Contains("truncated") && Catch::Contains("offset"));
   write_all(path, good.substr(0, 20));
-  CHECK_THROWS_WITH(VocabularyTree::load(path), Catch::Contains(path) && Catch::Contains("truncated while reading the node count at offset 20"));
+  CHECK_THROWS_WITH(VocabularyTree::load(path),
+                    Catch::Contains(path) && Catch::Contains("truncated while reading the node count at offset 20"));
   std::string bad = good;
   bad[0] = 'X';
   write_all(path, bad);
