@@ -30,12 +30,12 @@ cv::Mat orb_of_frame(int index, int max_points = 300) {
 }
 
 const std::vector<cv::Mat>& training_set() {
-  static const std::vector<cv::Mat> set = [] {
+  static const std::vector<cv::Mat> kSet = [] {
     std::vector<cv::Mat> s;
     for (int i : {0, 15, 30, 45, 60, 75, 90}) s.push_back(orb_of_frame(i, 250));
     return s;
   }();
-  return set;
+  return kSet;
 }
 
 VocabularyOptions small_options(uint64_t seed = 7) {
@@ -47,8 +47,8 @@ VocabularyOptions small_options(uint64_t seed = 7) {
 }
 
 const VocabularyTree& small_tree() {
-  static const VocabularyTree t = VocabularyTree::build(training_set(), small_options());
-  return t;
+  static const VocabularyTree kTree = VocabularyTree::build(training_set(), small_options());
+  return kTree;
 }
 
 /// A file in the system's temporary directory, unique per process (the Release and TSan passes may overlap).
