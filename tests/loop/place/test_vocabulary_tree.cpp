@@ -155,3 +155,7 @@ TEST_CASE("vocabulary tree: build rejects bad input") {
   CHECK_THROWS(VocabularyTree::build({}, small_options()));
   CHECK_THROWS(VocabularyTree::build({cv::Mat(3, 16, CV_8UC1)}, small_options()));
 }
+
+TEST_CASE("vocabulary tree: build_vocabulary, the entry point of `dynavins vocab`, is VocabularyTree::build") {
+  CHECK(build_vocabulary(training_set(), small_options()) == small_tree());
+}
