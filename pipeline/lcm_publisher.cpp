@@ -100,8 +100,12 @@ void LcmPublisher::process(PublishItem item) {
         } else if constexpr (std::is_same_v<T, WeightedFeatureSet>) {
           send(channels_.features, to_lcm(x), stats_.feature_sets);
         } else {
+          // A change (new status or an event) goes out at once; otherwise the status is only
+          // refreshed, and publishPeriodic() sends it with the reason of the change that led to it.
+          const bool change = !last_status_ || x.status != last_status_->status || !x.reason.empty();
+          if (!change) x.reason = last_status_->reason;
           last_status_ = x;
-          publishStatus();
+          if (change) publishStatus();
         }
       },
       item.payload);

@@ -83,10 +83,8 @@ void WriterStage::process(estimator::WindowEstimate e) {
   ++frames;
   resets += e.status == estimator::EstimatorStatus::Reset;
   if (!publish) return;
-  if (e.status != last_status || !e.event.empty()) {
-    last_status = e.status;
-    publish(PublishItem{0, StatusUpdate{e.t_ns, e.status, e.event, frames, resets}});
-  }
+  // Every frame: the publisher sends a change at once and the current status once a second.
+  publish(PublishItem{0, StatusUpdate{e.t_ns, e.status, e.event, frames, resets}});
   if (e.status != estimator::EstimatorStatus::Tracking) return;
   publish(PublishItem{e.received_ns, PoseEstimate{PoseSource::Window, e.state}});
   publish(PublishItem{0, std::move(e.features)});
@@ -131,7 +129,7 @@ VioStages::VioStages(const VioRunOptions& o, std::function<void(const TrackedFra
       imu{ImuStage(ImuStageOptions::from(o.estimator, o.imu_rate_hz, o.imu_noise)), latest, {},
           ImuPropagator(ImuPropagatorOptions{o.estimator.g_norm})},
       estimator{FrameImuPairer{}, estimator::SlidingWindowEstimator(estimatorOptions(o), o.mode), latest, gyro_bias},
-      writer{std::move(on_estimate), {}, 0, 0, std::nullopt} {}
+      writer{std::move(on_estimate), {}, 0, 0} {}
 
 void VioStages::collect(VioRunResult& r) const {
   r.gyro_prediction = predict;

@@ -89,15 +89,14 @@ struct EstimatorStage {
   int64_t tracking = 0, resets = 0;
 };
 
-/// Writer: hands each estimate to the run's sink and, with `publish`, its window pose, weighted features
-/// and (when it changes) the estimator's status to the publisher.
+/// Writer: hands each estimate to the run's sink and, with `publish`, its status, window pose and weighted
+/// features to the publisher.
 struct WriterStage {
   void process(estimator::WindowEstimate e);
 
   std::function<void(const estimator::WindowEstimate&)> sink;
   std::function<void(PublishItem)> publish;  ///< may be empty
   int64_t frames = 0, resets = 0;
-  std::optional<estimator::EstimatorStatus> last_status;
 };
 
 /// Every stage of one run and the feedback snapshots between them, built from the run's options.
