@@ -36,10 +36,18 @@ struct LoopScenario {
       const double off = lap == 0 ? 0.0 : 0.3;  // lap 2 runs 0.3 m inside the square
       double x = 0, y = 0;
       switch (side) {
-        case 0: x = s, y = off; break;
-        case 1: x = 10.0 - off, y = s; break;
-        case 2: x = 10.0 - s, y = 10.0 - off; break;
-        default: x = off, y = 10.0 - s; break;
+        case 0:
+          x = s, y = off;
+          break;
+        case 1:
+          x = 10.0 - off, y = s;
+          break;
+        case 2:
+          x = 10.0 - s, y = 10.0 - off;
+          break;
+        default:
+          x = off, y = 10.0 - s;
+          break;
       }
       const double yaw = side * 90.0 * kDeg;
       const double z = 0.2 * std::sin(0.15 * k);
@@ -70,7 +78,8 @@ struct LoopScenario {
   static int lap2_group(int j) { return kPerLap / 10 + j; }
 
   void add_true_loop(int query, int match) {
-    push(query, match, compose(inverse(gt[static_cast<std::size_t>(match)]), gt[static_cast<std::size_t>(query)]), true);
+    push(query, match, compose(inverse(gt[static_cast<std::size_t>(match)]), gt[static_cast<std::size_t>(query)]),
+         true);
   }
   /// A loop against an object that moved by `shift` since it was seen: the match is the lap-1 keyframe
   /// closest to where the relocated features say the query is.

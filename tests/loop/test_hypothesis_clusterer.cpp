@@ -65,8 +65,8 @@ TEST_CASE("HypothesisClusterer: loops on static features agree -> one hypothesis
   const Scene s;
   std::vector<GroupLoop> loops;
   for (std::size_t j = 0; j < 6; ++j)
-    loops.push_back(s.loop(100 + j, static_cast<int>(j + 2), -1.0 + 0.3 * j, 0.2 * j, Eigen::Vector3d::Zero(),
-                           jitter_of(j)));
+    loops.push_back(
+        s.loop(100 + j, static_cast<int>(j + 2), -1.0 + 0.3 * j, 0.2 * j, Eigen::Vector3d::Zero(), jitter_of(j)));
   const GroupHypotheses h = HypothesisClusterer().cluster(s.odom[0], loops);
   REQUIRE(h.hypotheses.size() == 1);
   CHECK(h.hypotheses[0].loop_indices == std::vector<std::size_t>{100, 101, 102, 103, 104, 105});
@@ -75,7 +75,8 @@ TEST_CASE("HypothesisClusterer: loops on static features agree -> one hypothesis
   CHECK(std::abs(pitch_of(h.hypotheses[0].T_W_i.q) - 2.0 * kDeg) < 1.0 * kDeg);
 }
 
-TEST_CASE("HypothesisClusterer: a relocated object gives a second hypothesis, the top two by size are kept", "[loop][cluster]") {
+TEST_CASE("HypothesisClusterer: a relocated object gives a second hypothesis, the top two by size are kept",
+          "[loop][cluster]") {
   const Scene s;
   const Eigen::Vector3d moved(2.0, 0.0, 0.0);    // object moved 2 m
   const Eigen::Vector3d moved2(0.0, -5.0, 0.0);  // another one moved 5 m

@@ -43,8 +43,7 @@ TEST_CASE("KeyframeGrouper: a group grows while |F_i^k| >= alpha, then the next 
   CHECK(g.num_dropped() == 0);
 }
 
-TEST_CASE("KeyframeGrouper: a feature must be tracked through every keyframe, not only seen again",
-          "[loop][grouper]") {
+TEST_CASE("KeyframeGrouper: a feature must be tracked through every keyframe, not only seen again", "[loop][grouper]") {
   KeyframeGrouperOptions opt;
   opt.min_shared_features = 25;
   opt.min_group_size = 1;

@@ -3,6 +3,7 @@
 // odometry's; the yaw manifold handles the ±pi wrap; Huber and switchable edges behave as documented.
 #include "tests/estimator/catch_with_ceres.hpp"  // first: Catch's CHECK, not glog's
 
+#include <algorithm>
 #include <unordered_map>
 
 #include "stages/loop/graph/pose_graph_4dof.hpp"
@@ -18,7 +19,8 @@ std::vector<LoopEdge> edges_of(const LoopScenario& s) {
   std::unordered_map<int64_t, int> node;
   for (std::size_t k = 0; k < s.t_ns.size(); ++k) node[s.t_ns[k]] = static_cast<int>(k);
   std::vector<LoopEdge> e;
-  for (const VerifiedLoop& l : s.loops) e.push_back(LoopEdge{node[l.match_t_ns], node[l.query_t_ns], RigidPose{l.p_mq, l.q_mq}, 1.0});
+  for (const VerifiedLoop& l : s.loops)
+    e.push_back(LoopEdge{node[l.match_t_ns], node[l.query_t_ns], RigidPose{l.p_mq, l.q_mq}, 1.0});
   return e;
 }
 }  // namespace
@@ -46,9 +48,9 @@ TEST_CASE("PoseGraph4Dof: exact loops remove the drift, roll and pitch stay", "[
   const PoseGraphSolveReport r = g.solve(edges, LoopEdgeLoss::Plain);
   for (const LoopEdge& e : edges) R_after += g.loop_residual_sq(e);
   const double after = s.rmse(g.poses());
-  WARN("pose graph, 24 exact loops: RMSE " << before << " m -> " << after << " m, end error "
-                                            << s.end_error(s.odom) << " -> " << s.end_error(g.poses())
-                                            << " m; sum loop r^2 " << R_before << " -> " << R_after);
+  WARN("pose graph, 24 exact loops: RMSE " << before << " m -> " << after << " m, end error " << s.end_error(s.odom)
+                                           << " -> " << s.end_error(g.poses()) << " m; sum loop r^2 " << R_before
+                                           << " -> " << R_after);
   CHECK(r.usable);
   CHECK(before > 1.0);
   CHECK(after < 0.35 * before);  // the odometry's 3 % scale error stays between loops
@@ -59,6 +61,17 @@ TEST_CASE("PoseGraph4Dof: exact loops remove the drift, roll and pitch stay", "[
     CHECK(std::abs(roll_of(g.pose(k).q) - roll_of(s.odom[k].q)) < 1e-9);
   }
   CHECK((g.pose(0).p - s.odom[0].p).norm() == 0.0);  // gauge
+}
+
+TEST_CASE("PoseGraph4Dof: loop residuals vanish at the truth and grow with the error", "[loop][posegraph]") {
+  LoopScenario s(0.0, 1.0, 0.0);  // no drift: the odometry is the truth
+  for (int j = 0; j < 8; ++j) s.add_true_loops_in_group(j);
+  s.add_false_loop(150, Eigen::Vector3d(0.3, 0.0, 0.0));
+  const PoseGraph4Dof g(s.odom);
+  const std::vector<LoopEdge> edges = edges_of(s);
+  for (std::size_t l = 0; l + 1 < edges.size(); ++l) CHECK(g.loop_residual_sq(edges[l]) < 1e-18);
+  // 0.3 m of translation error at sigma 0.1 m: ||r||^2 = 9 (the false loop's yaw is right).
+  CHECK(g.loop_residual_sq(edges.back()) == Approx(9.0).epsilon(1e-9));
 }
 
 TEST_CASE("PoseGraph4Dof: yaw across +-pi", "[loop][posegraph]") {
@@ -104,8 +117,8 @@ TEST_CASE("PoseGraph4Dof: Huber and switchable edges limit false loops", "[loop]
     else s_false_max = std::max(s_false_max, sv[l]);
   }
   WARN("four 2.5 m false loops, RMSE: true loops only " << e_ref << ", plain " << e_plain << ", huber " << e_huber
-                                                       << ", switchable " << e_sw << " (true s >= " << s_true_min
-                                                       << ", false s <= " << s_false_max << ")");
+                                                        << ", switchable " << e_sw << " (true s >= " << s_true_min
+                                                        << ", false s <= " << s_false_max << ")");
   CHECK(e_plain > 1.5 * e_ref);
   CHECK(e_huber < e_plain);
   CHECK(e_sw < 1.1 * e_ref);

@@ -14,7 +14,7 @@ RigidPose loop_query_pose(const RigidPose& T_W_m, const RigidPose& T_m_k) {
 RigidPose loop_group_start_pose(const RigidPose& T_W_m, const RigidPose& T_m_k, const RigidPose& T_W_k_odom,
                                 const RigidPose& T_W_i_odom) {
   const RigidPose T_k_i = compose(inverse(T_W_k_odom), T_W_i_odom);  // local relative pose, odometry
-  return compose(loop_query_pose(T_W_m, T_m_k), T_k_i);               // eq. 14 (paper: T_k^i . _mT_W^k)
+  return compose(loop_query_pose(T_W_m, T_m_k), T_k_i);              // eq. 14 (paper: T_k^i . _mT_W^k)
 }
 
 bool estimates_agree(const RigidPose& a, const RigidPose& b, const HypothesisClustererOptions& options) {

@@ -13,9 +13,9 @@
 namespace dynavins::loop {
 
 struct HypothesisClustererOptions {
-  double max_translation_m = 0.5;                        ///< two estimates agree within this distance ...
+  double max_translation_m = 0.5;                              ///< two estimates agree within this distance ...
   double max_yaw_rad = 10.0 * 3.14159265358979323846 / 180.0;  ///< ... and this yaw difference (DESIGN.md §1)
-  int max_hypotheses = 2;                                ///< top-two clusters by cardinality (IV-B)
+  int max_hypotheses = 2;                                      ///< top-two clusters by cardinality (IV-B)
 };
 
 /// One loop of a group, as the clusterer needs it.
@@ -29,7 +29,7 @@ struct GroupLoop {
 /// One hypothesis: the loops of one cluster and the mean of their estimates of T_W^i.
 struct LoopHypothesis {
   std::vector<std::size_t> loop_indices;  ///< GroupLoop::loop_index of the members, in input order
-  RigidPose T_W_i;                        ///< mean estimate (mean translation, circular-mean yaw, first member's roll/pitch)
+  RigidPose T_W_i;  ///< mean estimate (mean translation, circular-mean yaw, first member's roll/pitch)
 };
 
 struct GroupHypotheses {

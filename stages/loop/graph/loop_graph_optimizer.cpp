@@ -134,8 +134,7 @@ LoopGraphResult LoopGraphOptimizer::optimize_dynavins(PoseGraph4Dof& graph) cons
       next.push_back(std::move(w));
     }
     bool same = round > 0 && next.size() == state.size();
-    for (std::size_t a = 0; same && a < next.size(); ++a)
-      same = next[a].h0 == state[a].h0 && next[a].h1 == state[a].h1;
+    for (std::size_t a = 0; same && a < next.size(); ++a) same = next[a].h0 == state[a].h0 && next[a].h1 == state[a].h1;
     if (same) break;
     // After the first round the poses are already corrected: a group starts from its previous weights
     // if its hypotheses are unchanged, else from a weight step at the current poses.
@@ -167,8 +166,10 @@ LoopGraphResult LoopGraphOptimizer::optimize_dynavins(PoseGraph4Dof& graph) cons
   graph.solve(weighted_edges(state), LoopEdgeLoss::Plain);
   ++result.alternations;
   for (const GroupWeights& w : state) {
-    for (std::size_t l : w.h0) result.loops[l].hypothesis = 0, result.loops[l].weight = w.w0, result.loops[l].used = w.w0 > 0.0;
-    for (std::size_t l : w.h1) result.loops[l].hypothesis = 1, result.loops[l].weight = w.w1, result.loops[l].used = w.w1 > 0.0;
+    for (std::size_t l : w.h0)
+      result.loops[l].hypothesis = 0, result.loops[l].weight = w.w0, result.loops[l].used = w.w0 > 0.0;
+    for (std::size_t l : w.h1)
+      result.loops[l].hypothesis = 1, result.loops[l].weight = w.w1, result.loops[l].used = w.w1 > 0.0;
   }
   result.groups = state;
   result.poses = graph.poses();

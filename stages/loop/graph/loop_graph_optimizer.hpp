@@ -23,10 +23,10 @@ namespace dynavins::loop {
 struct LoopGraphOptions {
   HypothesisClustererOptions clustering;
   PoseGraphOptions graph;
-  double lambda_l = 1.0;          ///< eq. 16 (DESIGN.md §1)
-  int max_alternations = 10;      ///< weight step + pose solve pairs per round
-  double weight_tolerance = 1e-3; ///< the alternation stops when no weight moves more than this
-  int max_rounds = 3;             ///< re-clusterings; stops early when the hypotheses no longer change
+  double lambda_l = 1.0;           ///< eq. 16 (DESIGN.md §1)
+  int max_alternations = 10;       ///< weight step + pose solve pairs per round
+  double weight_tolerance = 1e-3;  ///< the alternation stops when no weight moves more than this
+  int max_rounds = 3;              ///< re-clusterings; stops early when the hypotheses no longer change
 };
 
 /// What became of one loop (for loops.csv).

@@ -15,10 +15,14 @@ LoopMode parse_loop_mode(const std::string& s) {
 
 const char* loop_mode_name(LoopMode mode) {
   switch (mode) {
-    case LoopMode::Off: return "off";
-    case LoopMode::All: return "all";
-    case LoopMode::Switchable: return "switchable";
-    case LoopMode::Dynavins: return "dynavins";
+    case LoopMode::Off:
+      return "off";
+    case LoopMode::All:
+      return "all";
+    case LoopMode::Switchable:
+      return "switchable";
+    case LoopMode::Dynavins:
+      return "dynavins";
   }
   return "?";
 }

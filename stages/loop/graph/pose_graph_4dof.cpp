@@ -154,12 +154,11 @@ PoseGraphSolveReport PoseGraph4Dof::solve(const std::vector<LoopEdge>& loops, Lo
                         options_.seq_sigma_t_m,
                         options_.seq_sigma_yaw_rad,
                         1.0};
-    problem.AddResidualBlock(new ceres::AutoDiffCostFunction<RelativePoseError, 4, 3, 1, 3, 1>(new RelativePoseError(f)),
-                             nullptr, nodes_[i].p, nodes_[i].yaw, nodes_[i + 1].p, nodes_[i + 1].yaw);
+    problem.AddResidualBlock(
+        new ceres::AutoDiffCostFunction<RelativePoseError, 4, 3, 1, 3, 1>(new RelativePoseError(f)), nullptr,
+        nodes_[i].p, nodes_[i].yaw, nodes_[i + 1].p, nodes_[i + 1].yaw);
   }
 
-  if (loss == LoopEdgeLoss::Switchable && switches != nullptr && switches->size() != loops.size())
-    switches->assign(loops.size(), 1.0);
   std::vector<double> local_switches;
   std::vector<double>& s = (switches != nullptr) ? *switches : local_switches;
   if (loss == LoopEdgeLoss::Switchable && s.size() != loops.size()) s.assign(loops.size(), 1.0);
@@ -173,26 +172,24 @@ PoseGraphSolveReport PoseGraph4Dof::solve(const std::vector<LoopEdge>& loops, Lo
       problem.AddResidualBlock(
           new ceres::AutoDiffCostFunction<SwitchedPoseError, 4, 3, 1, 3, 1, 1>(new SwitchedPoseError{f}), nullptr,
           nodes_[m].p, nodes_[m].yaw, nodes_[k].p, nodes_[k].yaw, &s[l]);
-      problem.AddResidualBlock(new ceres::AutoDiffCostFunction<SwitchPrior, 1, 1>(
-                                   new SwitchPrior{options_.switch_prior_sigma}),
-                               nullptr, &s[l]);
+      problem.AddResidualBlock(
+          new ceres::AutoDiffCostFunction<SwitchPrior, 1, 1>(new SwitchPrior{options_.switch_prior_sigma}), nullptr,
+          &s[l]);
       problem.SetParameterLowerBound(&s[l], 0, 0.0);
       problem.SetParameterUpperBound(&s[l], 0, 1.0);
+    } else if (loss == LoopEdgeLoss::Huber) {
+      // Huber on the whitened residual, times scale^2 outside (ScaledLoss), so the kink stays at delta.
+      RelativePoseError unscaled = f;
+      unscaled.scale = 1.0;
+      auto* lf =
+          new ceres::ScaledLoss(new ceres::HuberLoss(options_.huber_delta), e.scale * e.scale, ceres::TAKE_OWNERSHIP);
+      problem.AddResidualBlock(
+          new ceres::AutoDiffCostFunction<RelativePoseError, 4, 3, 1, 3, 1>(new RelativePoseError(unscaled)), lf,
+          nodes_[m].p, nodes_[m].yaw, nodes_[k].p, nodes_[k].yaw);
     } else {
-      ceres::LossFunction* lf = nullptr;
-      if (loss == LoopEdgeLoss::Huber) {
-        // Huber on the whitened residual, scaled by scale^2 outside (ScaledLoss) so the kink stays at delta.
-        const double d = options_.huber_delta;
-        RelativePoseError unscaled = f;
-        unscaled.scale = 1.0;
-        lf = new ceres::ScaledLoss(new ceres::HuberLoss(d), e.scale * e.scale, ceres::TAKE_OWNERSHIP);
-        problem.AddResidualBlock(
-            new ceres::AutoDiffCostFunction<RelativePoseError, 4, 3, 1, 3, 1>(new RelativePoseError(unscaled)), lf,
-            nodes_[m].p, nodes_[m].yaw, nodes_[k].p, nodes_[k].yaw);
-        continue;
-      }
-      problem.AddResidualBlock(new ceres::AutoDiffCostFunction<RelativePoseError, 4, 3, 1, 3, 1>(new RelativePoseError(f)),
-                               lf, nodes_[m].p, nodes_[m].yaw, nodes_[k].p, nodes_[k].yaw);
+      problem.AddResidualBlock(
+          new ceres::AutoDiffCostFunction<RelativePoseError, 4, 3, 1, 3, 1>(new RelativePoseError(f)), nullptr,
+          nodes_[m].p, nodes_[m].yaw, nodes_[k].p, nodes_[k].yaw);
     }
   }
 

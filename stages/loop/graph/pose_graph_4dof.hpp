@@ -22,9 +22,9 @@ struct PoseGraphOptions {
   double seq_sigma_yaw_rad = 1.0 * 3.14159265358979323846 / 180.0;   ///< sequential edge, yaw
   double loop_sigma_t_m = 0.1;                                       ///< loop edge (P_L), translation [m]
   double loop_sigma_yaw_rad = 1.0 * 3.14159265358979323846 / 180.0;  ///< loop edge (P_L), yaw
-  double huber_delta = 1.0;     ///< Huber loss of LoopEdgeLoss::Huber, on the whitened residual
+  double huber_delta = 1.0;         ///< Huber loss of LoopEdgeLoss::Huber, on the whitened residual
   double switch_prior_sigma = 1.0;  ///< switchable constraints: prior residual (1 - s) / sigma (Ξ = sigma^2)
-  int max_iterations = 100;     ///< Ceres iterations per solve
+  int max_iterations = 100;         ///< Ceres iterations per solve
 };
 
 /// A loop edge between keyframe nodes `match` (C_m) and `query` (C_k, newer).
