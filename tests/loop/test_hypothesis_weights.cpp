@@ -24,9 +24,9 @@ HypothesisWeights brute_force(double R0, int n0, double R1, int n1, double lambd
 
 TEST_CASE("solve_hypothesis_weights matches a brute-force minimisation of eq. 16-17", "[loop][weights]") {
   struct Case {
-    double R0;
+    double res0;  // R_0
     int n0;
-    double R1;
+    double res1;  // R_1
     int n1;
     double lambda;
   };
@@ -34,13 +34,13 @@ TEST_CASE("solve_hypothesis_weights matches a brute-force minimisation of eq. 16
                         {0.0, 3, 50.0, 2, 1.0},  {10.0, 1, 10.0, 1, 0.5}, {5.0, 6, 0.0, 0, 1.0},
                         {90.0, 3, 0.0, 0, 1.0},  {1.0, 2, 1.0, 7, 3.0}};
   for (const Case& c : cases) {
-    const HypothesisWeights w = solve_hypothesis_weights(c.R0, c.n0, c.R1, c.n1, c.lambda);
-    const HypothesisWeights b = brute_force(c.R0, c.n0, c.R1, c.n1, c.lambda);
-    INFO("R0 " << c.R0 << " n0 " << c.n0 << " R1 " << c.R1 << " n1 " << c.n1 << " lambda " << c.lambda);
+    const HypothesisWeights w = solve_hypothesis_weights(c.res0, c.n0, c.res1, c.n1, c.lambda);
+    const HypothesisWeights b = brute_force(c.res0, c.n0, c.res1, c.n1, c.lambda);
+    INFO("R0 " << c.res0 << " n0 " << c.n0 << " R1 " << c.res1 << " n1 " << c.n1 << " lambda " << c.lambda);
     CHECK(w.w0 == Approx(b.w0).margin(2e-3));
     CHECK(w.w1 == Approx(b.w1).margin(2e-3));
-    const double e = hypothesis_weight_energy(w.w0, w.w1, c.R0, c.n0, c.R1, c.n1, c.lambda);
-    CHECK(e <= hypothesis_weight_energy(b.w0, b.w1, c.R0, c.n0, c.R1, c.n1, c.lambda) + 1e-12);
+    const double e = hypothesis_weight_energy(w.w0, w.w1, c.res0, c.n0, c.res1, c.n1, c.lambda);
+    CHECK(e <= hypothesis_weight_energy(b.w0, b.w1, c.res0, c.n0, c.res1, c.n1, c.lambda) + 1e-12);
     CHECK(w.w0 >= 0.0);
     CHECK(w.w1 >= 0.0);
     CHECK(w.w0 + w.w1 <= 1.0 + 1e-12);

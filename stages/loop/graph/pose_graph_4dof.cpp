@@ -17,15 +17,18 @@ T normalize_angle_t(const T& a) {
   return a - T(2.0 * kPi) * ceres::floor((a + T(kPi)) / T(2.0 * kPi));
 }
 
-/// Yaw parameter on the circle: x ⊞ δ = normalize(x + δ) (Ceres examples' AngleManifold).
+/// Yaw parameter on the circle: x ⊞ δ = normalize(x + δ) (Ceres examples' AngleManifold). Plus and
+/// Minus are the names ceres::AutoDiffManifold calls (a library-fixed interface, CONTRIBUTING.md).
 struct AnglePlus {
   template <typename T>
-  bool Plus(const T* x, const T* delta, T* x_plus_delta) const {
+  bool Plus(  // NOLINT(readability-identifier-naming)
+      const T* x, const T* delta, T* x_plus_delta) const {
     x_plus_delta[0] = normalize_angle_t(x[0] + delta[0]);
     return true;
   }
   template <typename T>
-  bool Minus(const T* y, const T* x, T* y_minus_x) const {
+  bool Minus(  // NOLINT(readability-identifier-naming)
+      const T* y, const T* x, T* y_minus_x) const {
     y_minus_x[0] = normalize_angle_t(y[0] - x[0]);
     return true;
   }
