@@ -1,0 +1,179 @@
+// Selective global optimisation, paper IV (see loop_graph_optimizer.hpp).
+#include "stages/loop/graph/loop_graph_optimizer.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+#include "stages/loop/graph/hypothesis_weights.hpp"
+
+namespace dynavins::loop {
+
+LoopGraphOptimizer::LoopGraphOptimizer(const LoopGraphOptions& options) : options_(options) {}
+
+void LoopGraphOptimizer::add_keyframe(int64_t t_ns, const RigidPose& T_W_k_odom) {
+  node_of_[t_ns] = static_cast<int>(odometry_.size());
+  t_ns_.push_back(t_ns);
+  odometry_.push_back(T_W_k_odom);
+  group_of_node_.push_back(-1);
+}
+
+bool LoopGraphOptimizer::add_group(const KeyframeGroup& group) {
+  if (group.t_ns.empty()) return false;
+  for (int64_t t : group.t_ns)
+    if (node_of_.count(t) == 0) return false;
+  const int g = static_cast<int>(groups_.size());
+  groups_.push_back(group);
+  for (int64_t t : group.t_ns) group_of_node_[static_cast<std::size_t>(node_of_.at(t))] = g;
+  for (std::size_t l = 0; l < loops_.size(); ++l)
+    if (group_of_node_[static_cast<std::size_t>(loop_nodes_[l].query)] == g) loop_nodes_[l].group = g;
+  return true;
+}
+
+bool LoopGraphOptimizer::add_loop(const VerifiedLoop& loop) {
+  const auto m = node_of_.find(loop.match_t_ns);
+  const auto k = node_of_.find(loop.query_t_ns);
+  if (m == node_of_.end() || k == node_of_.end() || m->second >= k->second) return false;
+  loops_.push_back(loop);
+  loop_nodes_.push_back(LoopNodes{m->second, k->second, group_of_node_[static_cast<std::size_t>(k->second)]});
+  return true;
+}
+
+namespace {
+RigidPose relative_of(const VerifiedLoop& l) { return RigidPose{l.p_mq, l.q_mq.normalized()}; }
+}  // namespace
+
+LoopGraphResult LoopGraphOptimizer::optimize(LoopMode mode) const {
+  PoseGraph4Dof graph(odometry_, options_.graph);
+  if (mode == LoopMode::Dynavins) return optimize_dynavins(graph);
+
+  LoopGraphResult result;
+  result.loops.resize(loops_.size());
+  std::vector<LoopEdge> edges;
+  for (std::size_t l = 0; l < loops_.size(); ++l) {
+    result.loops[l].loop_index = l;
+    result.loops[l].group = loop_nodes_[l].group;
+    edges.push_back(LoopEdge{loop_nodes_[l].match, loop_nodes_[l].query, relative_of(loops_[l]), 1.0});
+  }
+  if (mode == LoopMode::All && !edges.empty()) {
+    graph.solve(edges, LoopEdgeLoss::Huber);  // VINS-Fusion: every loop, Huber
+    for (LoopResult& r : result.loops) r.weight = 1.0, r.used = true;
+    result.alternations = 1;
+  } else if (mode == LoopMode::Switchable && !edges.empty()) {
+    std::vector<double> s(edges.size(), 1.0);
+    graph.solve(edges, LoopEdgeLoss::Switchable, &s);
+    for (std::size_t l = 0; l < s.size(); ++l) result.loops[l].weight = s[l], result.loops[l].used = s[l] > 0.0;
+    result.alternations = 1;
+  }
+  result.rounds = 1;
+  result.poses = graph.poses();
+  return result;
+}
+
+std::vector<LoopEdge> LoopGraphOptimizer::weighted_edges(const std::vector<GroupWeights>& state) const {
+  std::vector<LoopEdge> edges;
+  for (const GroupWeights& w : state) {
+    // eq. 16: each loop residual of H^h scaled by w^h / |H^h| (inside the norm, so the cost has (w/|H|)^2).
+    for (std::size_t l : w.h0)
+      edges.push_back(LoopEdge{loop_nodes_[l].match, loop_nodes_[l].query, relative_of(loops_[l]),
+                               w.w0 / static_cast<double>(w.h0.size())});
+    for (std::size_t l : w.h1)
+      edges.push_back(LoopEdge{loop_nodes_[l].match, loop_nodes_[l].query, relative_of(loops_[l]),
+                               w.w1 / static_cast<double>(w.h1.size())});
+  }
+  return edges;
+}
+
+HypothesisWeights LoopGraphOptimizer::weight_step(const PoseGraph4Dof& graph, const GroupWeights& w) const {
+  auto residual_sum = [&](const std::vector<std::size_t>& members) {  // R_h = sum ||r||^2_{P_L}
+    double R = 0.0;
+    for (std::size_t l : members)
+      R += graph.loop_residual_sq(LoopEdge{loop_nodes_[l].match, loop_nodes_[l].query, relative_of(loops_[l]), 1.0});
+    return R;
+  };
+  if (w.h0.empty()) return HypothesisWeights{};
+  return solve_hypothesis_weights(residual_sum(w.h0), static_cast<int>(w.h0.size()), residual_sum(w.h1),
+                                  static_cast<int>(w.h1.size()), options_.lambda_l);
+}
+
+LoopGraphResult LoopGraphOptimizer::optimize_dynavins(PoseGraph4Dof& graph) const {
+  LoopGraphResult result;
+  result.loops.resize(loops_.size());
+  for (std::size_t l = 0; l < loops_.size(); ++l) {
+    result.loops[l].loop_index = l;
+    result.loops[l].group = loop_nodes_[l].group;
+  }
+  const HypothesisClusterer clusterer(options_.clustering);
+
+  // Loops per group (only loops whose query lies in a kept group take part, IV-A).
+  std::vector<std::vector<std::size_t>> loops_of_group(groups_.size());
+  for (std::size_t l = 0; l < loops_.size(); ++l)
+    if (loop_nodes_[l].group >= 0) loops_of_group[static_cast<std::size_t>(loop_nodes_[l].group)].push_back(l);
+
+  std::vector<GroupWeights> state;  // per active group
+  for (int round = 0; round < std::max(1, options_.max_rounds); ++round) {
+    // IV-B: (re-)cluster every group's loops with the current poses of the match keyframes.
+    std::vector<GroupWeights> next;
+    for (std::size_t g = 0; g < groups_.size(); ++g) {
+      if (loops_of_group[g].empty()) continue;
+      std::vector<GroupLoop> gl;
+      for (std::size_t l : loops_of_group[g]) {
+        const auto m = static_cast<std::size_t>(loop_nodes_[l].match);
+        const auto k = static_cast<std::size_t>(loop_nodes_[l].query);
+        gl.push_back(GroupLoop{l, graph.pose(m), relative_of(loops_[l]), odometry_[k]});
+      }
+      const int first = node_of_.at(groups_[g].first_t_ns());
+      const GroupHypotheses h = clusterer.cluster(odometry_[static_cast<std::size_t>(first)], gl);
+      GroupWeights w;
+      w.group = static_cast<int>(g);
+      if (!h.hypotheses.empty()) w.h0 = h.hypotheses[0].loop_indices;
+      if (h.hypotheses.size() > 1) w.h1 = h.hypotheses[1].loop_indices;
+      // First round: the poses are the drifted odometry, every loop looks wrong, so the alternation starts
+      // with a pose step at weights summing to 1 (regulariser at its minimum), split evenly.
+      w.w0 = w.h1.empty() ? 1.0 : 0.5;
+      w.w1 = w.h1.empty() ? 0.0 : 0.5;
+      next.push_back(std::move(w));
+    }
+    bool same = round > 0 && next.size() == state.size();
+    for (std::size_t a = 0; same && a < next.size(); ++a) same = next[a].h0 == state[a].h0 && next[a].h1 == state[a].h1;
+    if (same) break;
+    // After the first round the poses are already corrected: a group starts from its previous weights
+    // if its hypotheses are unchanged, else from a weight step at the current poses.
+    for (std::size_t a = 0; round > 0 && a < next.size(); ++a) {
+      const HypothesisWeights nw = weight_step(graph, next[a]);
+      next[a].w0 = nw.w0, next[a].w1 = nw.w1;
+      for (const GroupWeights& old : state)
+        if (old.group == next[a].group && old.h0 == next[a].h0 && old.h1 == next[a].h1)
+          next[a].w0 = old.w0, next[a].w1 = old.w1;
+    }
+    state = std::move(next);
+    result.rounds = round + 1;
+
+    for (int it = 0; it < std::max(1, options_.max_alternations); ++it) {
+      // Pose step with the weights fixed (the regulariser does not depend on the poses).
+      graph.solve(weighted_edges(state), LoopEdgeLoss::Plain);
+      ++result.alternations;
+      // Weight step with the poses fixed: closed form (hypothesis_weights.cpp).
+      double max_change = 0.0;
+      for (GroupWeights& w : state) {
+        const HypothesisWeights nw = weight_step(graph, w);
+        max_change = std::max({max_change, std::abs(nw.w0 - w.w0), std::abs(nw.w1 - w.w1)});
+        w.w0 = nw.w0, w.w1 = nw.w1;
+      }
+      if (max_change < options_.weight_tolerance) break;
+    }
+  }
+  // Final pose solve with the settled weights, so poses and reported weights belong together.
+  graph.solve(weighted_edges(state), LoopEdgeLoss::Plain);
+  ++result.alternations;
+  for (const GroupWeights& w : state) {
+    for (std::size_t l : w.h0)
+      result.loops[l].hypothesis = 0, result.loops[l].weight = w.w0, result.loops[l].used = w.w0 > 0.0;
+    for (std::size_t l : w.h1)
+      result.loops[l].hypothesis = 1, result.loops[l].weight = w.w1, result.loops[l].used = w.w1 > 0.0;
+  }
+  result.groups = state;
+  result.poses = graph.poses();
+  return result;
+}
+
+}  // namespace dynavins::loop

@@ -1,0 +1,92 @@
+#pragma once
+// The selective global optimisation of paper IV as one object: keyframe nodes (odometry poses), keyframe
+// groups (eq. 12), verified loops; optimize(mode) runs the 4-DoF pose graph with the chosen loop handling
+// and returns the corrected poses and what became of every loop. In LoopMode::Dynavins it alternates, per
+// round, the closed-form hypothesis weight step (eq. 16-17) and the pose solve with the weights fixed,
+// then re-clusters every group's loops with the new poses (IV-C, last paragraph) for the next round.
+
+#include <cstddef>
+#include <cstdint>
+#include <unordered_map>
+#include <vector>
+
+#include "messages/keyframe.hpp"
+#include "stages/loop/graph/hypothesis_clusterer.hpp"
+#include "stages/loop/graph/hypothesis_weights.hpp"
+#include "stages/loop/graph/keyframe_grouper.hpp"
+#include "stages/loop/graph/loop_mode.hpp"
+#include "stages/loop/graph/pose_graph_4dof.hpp"
+#include "stages/loop/graph/rigid_pose.hpp"
+
+namespace dynavins::loop {
+
+struct LoopGraphOptions {
+  HypothesisClustererOptions clustering;
+  PoseGraphOptions graph;
+  double lambda_l = 1.0;           ///< eq. 16 (DESIGN.md §1)
+  int max_alternations = 10;       ///< weight step + pose solve pairs per round
+  double weight_tolerance = 1e-3;  ///< the alternation stops when no weight moves more than this
+  int max_rounds = 3;              ///< re-clusterings; stops early when the hypotheses no longer change
+};
+
+/// What became of one loop (for loops.csv).
+struct LoopResult {
+  std::size_t loop_index = 0;  ///< order of add_loop
+  int group = -1;              ///< index into groups() of the group holding the query, -1 if none
+  int hypothesis = -1;         ///< 0 or 1 (H^0, H^1) in LoopMode::Dynavins; -1 if outside the top two / other modes
+  double weight = 0.0;         ///< all: 1; switchable: s; dynavins: w^h of its hypothesis (0 if unused); off: 0
+  bool used = false;           ///< the loop entered the last pose solve with a non-zero weight
+};
+
+/// Per group and round, the hypotheses and their final weights (Dynavins only).
+struct GroupWeights {
+  int group = -1;
+  std::vector<std::size_t> h0, h1;  ///< loop indices of H^0, H^1
+  double w0 = 0.0, w1 = 0.0;
+};
+
+struct LoopGraphResult {
+  std::vector<RigidPose> poses;  ///< corrected T_W^k per keyframe, in add_keyframe order
+  std::vector<LoopResult> loops;
+  std::vector<GroupWeights> groups;  ///< last round's hypotheses and weights (Dynavins), groups with loops
+  int rounds = 0;
+  int alternations = 0;  ///< total pose solves
+};
+
+class LoopGraphOptimizer {
+ public:
+  explicit LoopGraphOptimizer(const LoopGraphOptions& options = {});
+
+  /// Keyframes in time order with their odometry pose T_W^k.
+  void add_keyframe(int64_t t_ns, const RigidPose& T_W_k_odom);
+  /// A kept group (KeyframeGrouper output); members must be known keyframes. Returns false otherwise.
+  bool add_group(const KeyframeGroup& group);
+  /// A verified loop between two known keyframes (match older than query). Returns false otherwise.
+  bool add_loop(const VerifiedLoop& loop);
+
+  std::size_t num_keyframes() const { return odometry_.size(); }
+  const std::vector<KeyframeGroup>& groups() const { return groups_; }
+  const std::vector<VerifiedLoop>& loops() const { return loops_; }
+
+  /// Runs the pose graph from the odometry (every call starts afresh).
+  LoopGraphResult optimize(LoopMode mode) const;
+
+ private:
+  struct LoopNodes {
+    int match = 0, query = 0, group = -1;
+  };
+  LoopGraphResult optimize_dynavins(PoseGraph4Dof& graph) const;
+  std::vector<LoopEdge> weighted_edges(const std::vector<GroupWeights>& state) const;
+  HypothesisWeights weight_step(const PoseGraph4Dof& graph, const GroupWeights& w) const;
+
+  LoopGraphOptions options_;
+  std::vector<int64_t> t_ns_;
+  std::vector<RigidPose> odometry_;
+  std::unordered_map<int64_t, int> node_of_;
+  std::vector<KeyframeGroup> groups_;
+  std::vector<int> group_of_node_;
+  std::vector<VerifiedLoop> loops_;
+  std::vector<LoopNodes> loop_nodes_;
+};
+
+}  // namespace dynavins::loop
