@@ -28,5 +28,6 @@ void add_run_command(CLI::App& app);
 void add_compare_command(CLI::App& app);
 void add_overlay_command(CLI::App& app);
 void add_decode_command(CLI::App& app);
+void add_live_command(CLI::App& app);
 
 }  // namespace dynavins::cli

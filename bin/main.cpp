@@ -32,6 +32,7 @@ int main(int argc, char** argv) {
   dynavins::cli::add_compare_command(app);
   dynavins::cli::add_overlay_command(app);
   dynavins::cli::add_decode_command(app);
+  dynavins::cli::add_live_command(app);
 
   try {
     app.parse(argc, argv);

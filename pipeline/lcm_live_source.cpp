@@ -20,7 +20,8 @@ namespace {
 
 constexpr int kPollMs = 20;
 
-/// Decodes `rbuf` as Msg; an empty message and `why` set when it is not one.
+/// Decodes `rbuf` as Msg: false when it is not one, with `wrong_type` set when its fingerprint is another
+/// type's (rather than a truncated or corrupt payload).
 template <typename Msg>
 bool decode(const lcm::ReceiveBuffer* rbuf, Msg& msg, bool& wrong_type) {
   int64_t hash = 0;
@@ -39,15 +40,26 @@ LiveSourceOptions::LiveSourceOptions()
     : stereo_channel(channels::kStereo), imu_channel(channels::kImu), ground_truth_channel(channels::kGroundTruth) {}
 
 LcmLiveSource::LcmLiveSource(LiveSourceOptions options, const std::atomic<bool>* stop)
-    : opt_(std::move(options)), stop_(stop), lcm_(std::make_unique<lcm::LCM>(opt_.url)) {
+    : opt_(std::move(options)), stop_(stop), owned_(std::make_unique<lcm::LCM>(opt_.url)), lcm_(owned_.get()) {
   if (!lcm_->good()) throw std::runtime_error("LCM cannot open '" + opt_.url + "' (check the URL and the network)");
-  lcm_->subscribe(opt_.stereo_channel, &LcmLiveSource::onStereo, this);
-  lcm_->subscribe(opt_.imu_channel, &LcmLiveSource::onImu, this);
-  if (!opt_.ground_truth_channel.empty())
-    lcm_->subscribe(opt_.ground_truth_channel, &LcmLiveSource::onGroundTruth, this);
+  subscribe();
 }
 
-LcmLiveSource::~LcmLiveSource() = default;
+LcmLiveSource::LcmLiveSource(lcm::LCM& lcm, LiveSourceOptions options, const std::atomic<bool>* stop)
+    : opt_(std::move(options)), stop_(stop), lcm_(&lcm) {
+  subscribe();
+}
+
+void LcmLiveSource::subscribe() {
+  subscriptions_.push_back(lcm_->subscribe(opt_.stereo_channel, &LcmLiveSource::onStereo, this));
+  subscriptions_.push_back(lcm_->subscribe(opt_.imu_channel, &LcmLiveSource::onImu, this));
+  if (!opt_.ground_truth_channel.empty())
+    subscriptions_.push_back(lcm_->subscribe(opt_.ground_truth_channel, &LcmLiveSource::onGroundTruth, this));
+}
+
+LcmLiveSource::~LcmLiveSource() {
+  for (lcm::Subscription* sub : subscriptions_) lcm_->unsubscribe(sub);
+}
 
 std::string LcmLiveSource::describe() const {
   return "live LCM " + opt_.url + " (" + opt_.stereo_channel + ", " + opt_.imu_channel + ")";
@@ -78,10 +90,10 @@ void LcmLiveSource::onStereo(const lcm::ReceiveBuffer* rbuf, const std::string& 
                   "an image of " + std::to_string(f.left.cols) + "x" + std::to_string(f.left.rows) +
                       " where the calibration says " + std::to_string(opt_.image_width) + "x" +
                       std::to_string(opt_.image_height));
-  if (f.t_ns <= last_frame_ns_ || f.t_ns <= released_ns_)
-    return reject(stats_.time_went_back, channel, "a frame not after the previous one");
+  if (f.t_ns <= last_frame_ns_) return reject(stats_.time_went_back, channel, "a frame not after the previous one");
   last_frame_ns_ = f.t_ns;
-  frames_.push_back(Held{std::move(f), steady_now_ns()});
+  ready_.push_back(std::move(f));
+  ++stats_.frames;
 }
 
 void LcmLiveSource::onImu(const lcm::ReceiveBuffer* rbuf, const std::string& channel) {
@@ -96,12 +108,9 @@ void LcmLiveSource::onImu(const lcm::ReceiveBuffer* rbuf, const std::string& cha
   } catch (const std::exception& e) {
     return reject(stats_.bad_imu, channel, e.what());
   }
-  if (s.t_ns <= last_imu_ns_ || s.t_ns < released_ns_)
-    return reject(stats_.time_went_back, channel, "an IMU sample not after the previous one");
+  if (s.t_ns <= last_imu_ns_) return reject(stats_.time_went_back, channel, "an IMU sample not after the previous one");
   last_imu_ns_ = s.t_ns;
-  releaseFrames(s.t_ns, false);
   ready_.push_back(s);
-  released_ns_ = s.t_ns;
   ++stats_.imu;
 }
 
@@ -124,27 +133,10 @@ void LcmLiveSource::onGroundTruth(const lcm::ReceiveBuffer* rbuf, const std::str
   ++stats_.ground_truth;
 }
 
-// Frames up to `up_to_ns` go on (their IMU has arrived); with `timed_out`, so do frames that waited too long.
-void LcmLiveSource::releaseFrames(int64_t up_to_ns, bool timed_out) {
-  const int64_t hold_ns = static_cast<int64_t>(opt_.frame_hold_s * 1e9);
-  const int64_t now = steady_now_ns();
-  while (!frames_.empty()) {
-    Held& h = frames_.front();
-    const bool covered = event_time_ns(h.event) <= up_to_ns;
-    if (!covered && !(timed_out && now - h.arrived_ns >= hold_ns)) break;
-    if (!covered) ++stats_.frames_without_imu;
-    released_ns_ = std::max(released_ns_, event_time_ns(h.event));
-    ready_.push_back(std::move(h.event));
-    frames_.pop_front();
-    ++stats_.frames;
-  }
-}
-
 bool LcmLiveSource::next(SensorEvent& out) {
   while (ready_.empty()) {
     if (stopRequested()) return false;
     if (lcm_->handleTimeout(kPollMs) < 0) throw std::runtime_error("LCM receive failed on " + opt_.url);
-    releaseFrames(last_imu_ns_, true);
   }
   out = std::move(ready_.front());
   ready_.pop_front();

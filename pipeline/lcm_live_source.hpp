@@ -3,9 +3,10 @@
 // IMU channels (and, when present, ground truth) and hands their messages on in time order, so the run
 // that follows is the same as a replay's.
 //
-// Order: LCM delivers the channels as they arrive, and a frame may come in before the IMU samples that
-// reach its time. A frame is therefore held until an IMU sample at or after its time has arrived (or
-// `frame_hold_s` of wall time passed), and everything is released in time order.
+// Order: each channel's messages go on as they arrive, so the IMU-rate pose is never held back; only
+// within a channel must time increase. Across channels no order is needed: a camera frame usually
+// arrives after the IMU samples past its time (image transfer), and the IMU stage cuts its interval from
+// the samples it keeps (ImuIntervalBuilder takes any interleaving).
 // Bad messages never reach the pipeline; each is counted by reason and the first of each kind is logged:
 // another type on the channel (fingerprint), a truncated or undecodable payload, an image whose size does
 // not match its width and height or the calibration, non-finite IMU values, and times that go back.
@@ -16,12 +17,14 @@
 #include <deque>
 #include <memory>
 #include <string>
+#include <vector>
 
 #include "io/sensor_source.hpp"
 
 namespace lcm {
 class LCM;
 class ReceiveBuffer;
+class Subscription;
 }  // namespace lcm
 
 namespace dynavins::pipeline {
@@ -32,7 +35,6 @@ struct LiveSourceOptions {
   std::string imu_channel;     ///< imu_t (default channels::kImu)
   std::string ground_truth_channel;  ///< ground_truth_t (default channels::kGroundTruth); empty: not read
   int image_width = 0, image_height = 0;  ///< the calibration's; 0 = not checked
-  double frame_hold_s = 0.2;              ///< wall time a frame waits for its IMU before it goes on anyway
   LiveSourceOptions();
 };
 
@@ -44,7 +46,6 @@ struct LiveSourceStats {
   int64_t bad_image = 0;        ///< image size not matching its width/height, or the calibration's
   int64_t bad_imu = 0;          ///< NaN or Inf in an IMU sample
   int64_t time_went_back = 0;   ///< a message not after the previous one on its channel
-  int64_t frames_without_imu = 0;  ///< frames released after frame_hold_s without an IMU sample past them
   int64_t rejected() const { return wrong_type + undecodable + bad_image + bad_imu + time_went_back; }
 };
 
@@ -52,6 +53,8 @@ class LcmLiveSource final : public io::SensorSource {
  public:
   /// Subscribes; throws std::runtime_error naming the URL if LCM cannot open it.
   explicit LcmLiveSource(LiveSourceOptions options, const std::atomic<bool>* stop = nullptr);
+  /// Subscribes on the caller's instance (tests on memq://, where only the same instance receives).
+  LcmLiveSource(lcm::LCM& lcm, LiveSourceOptions options, const std::atomic<bool>* stop = nullptr);
   ~LcmLiveSource() override;
 
   bool next(SensorEvent& out) override;
@@ -65,20 +68,17 @@ class LcmLiveSource final : public io::SensorSource {
   void onImu(const lcm::ReceiveBuffer* rbuf, const std::string& channel);
   void onGroundTruth(const lcm::ReceiveBuffer* rbuf, const std::string& channel);
   void reject(int64_t& counter, const std::string& channel, const std::string& why);
-  void releaseFrames(int64_t up_to_ns, bool timed_out);
   bool stopRequested() const;
 
   LiveSourceOptions opt_;
   const std::atomic<bool>* stop_;
-  std::unique_ptr<lcm::LCM> lcm_;
-  struct Held {
-    SensorEvent event;
-    int64_t arrived_ns = 0;  // steady clock
-  };
-  std::deque<Held> frames_;        // frames waiting for their IMU, in time order
-  std::deque<SensorEvent> ready_;  // in time order
+  void subscribe();
+
+  std::unique_ptr<lcm::LCM> owned_;
+  lcm::LCM* lcm_ = nullptr;
+  std::vector<lcm::Subscription*> subscriptions_;  // removed again in the destructor (a caller's instance)
+  std::deque<SensorEvent> ready_;  // received, not yet handed on (arrival order)
   int64_t last_frame_ns_ = INT64_MIN, last_imu_ns_ = INT64_MIN, last_gt_ns_ = INT64_MIN;
-  int64_t released_ns_ = INT64_MIN;  // newest time handed to ready_
   LiveSourceStats stats_;
 };
 

@@ -73,6 +73,7 @@ void checkVioOptions(const VioRunOptions& o) {
   if (o.mode.stereo && (o.estimator.num_of_cam < 2 || o.estimator.cameras.size() < 2))
     throw std::invalid_argument("stereo needs num_of_cam: 2 in the config; use --mono for one camera");
   if (o.rate < 0) throw std::invalid_argument("rate must be >= 0");
+  if (o.live && o.rate != 0) throw std::invalid_argument("a live source is not paced: rate must be 0");
   if (o.frame_queue == 0 || o.imu_queue == 0 || o.estimator_queue == 0 || o.output_queue == 0 ||
       o.publish_queue == 0)
     throw std::invalid_argument("queue capacities must be positive");
@@ -81,7 +82,7 @@ void checkVioOptions(const VioRunOptions& o) {
 VioRunResult runVio(io::SensorSource& source, const VioRunOptions& opt, const VioSinks& sinks,
                     const StopFlag* external_stop) {
   checkVioOptions(opt);
-  const bool paced = opt.rate > 0;
+  const bool paced = opt.realTime();
   VioRunResult result;
   result.source = source.describe();
   VioStages st(opt, sinks.tracked, sinks.estimate);

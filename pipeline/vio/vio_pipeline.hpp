@@ -49,6 +49,10 @@ struct VioRunOptions {
   EstimatorOptions estimator;        ///< the loaded yaml (with any --set overrides)
   estimator::EstimatorMode mode;     ///< BA loss, stereo or mono
   double rate = 0.0;                 ///< x real time; 0 = as fast as possible, lossless
+  /// The source is live (it delivers in real time by itself): no pacing, but real-time back-pressure
+  /// (oldest frames dropped when the tracker falls behind, solver time budget on). rate must be 0.
+  bool live = false;
+  bool realTime() const { return rate > 0 || live; }
   bool show_progress = true;         ///< replay progress line on the terminal
   double imu_rate_hz = 200.0;        ///< nominal IMU rate (gap detection)
   ImuNoiseConvention imu_noise = ImuNoiseConvention::VinsFusion;

@@ -113,7 +113,7 @@ std::optional<GyroRotationPredictor> gyroPredictor(const VioRunOptions& o, bool 
 // (max_solver_time) applies to paced runs, where the estimator must keep up.
 EstimatorOptions estimatorOptions(const VioRunOptions& o) {
   EstimatorOptions e = o.estimator;
-  if (o.rate <= 0) e.max_solver_time = std::numeric_limits<double>::infinity();
+  if (!o.realTime()) e.max_solver_time = std::numeric_limits<double>::infinity();
   return e;
 }
 
@@ -122,7 +122,7 @@ EstimatorOptions estimatorOptions(const VioRunOptions& o) {
 VioStages::VioStages(const VioRunOptions& o, std::function<void(const TrackedFrame&)> on_tracked,
                      std::function<void(const estimator::WindowEstimate&)> on_estimate)
     : predict(gyroPredictionUsable(o)),
-      solver_time_budget(o.rate > 0),
+      solver_time_budget(o.realTime()),
       tracker(StereoTracker(TrackerOptions::from(o.estimator), o.estimator.cameras.at(0),
                             o.mode.stereo ? o.estimator.cameras.at(1) : nullptr),
               !o.mode.stereo, gyroPredictor(o, predict), gyro_bias, std::move(on_tracked)),

@@ -1,0 +1,44 @@
+#pragma once
+// What `run` and `live` share: their estimator options on the command line, turning them into
+// VioRunOptions, and running the pipeline into an output folder with the end-of-run summary.
+
+#include <functional>
+#include <string>
+#include <vector>
+
+#include "io/sensor_source.hpp"
+#include "pipeline/vio/run_outputs.hpp"
+#include "pipeline/vio/vio_pipeline.hpp"
+
+namespace CLI {
+class App;
+}
+
+namespace dynavins::cli {
+
+struct VioCommandOptions {
+  std::string config;
+  std::string out;
+  std::string ba = "dynavins";
+  bool mono = false;
+  std::vector<std::string> set;
+  double imu_rate_hz = 200.0;
+  bool gyro_prediction = false;
+  std::string lcm_url;
+  std::vector<std::string> channels;  ///< output channel overrides, key=NAME
+
+  /// Adds --config, --out, --ba, --mono, --gyro-prediction, --set, --imu-rate, --lcm-url, --channel.
+  void add_options(CLI::App& cmd, const std::string& lcm_url_help);
+  /// The run's options (config loaded, overrides applied, checked); CommandError (exit 2) naming the
+  /// problem otherwise.
+  pipeline::VioRunOptions load(double rate) const;
+};
+
+/// Runs `source` into `out_dir` (odometry, features, events, summary.json), prints the summary and, if
+/// given, `extra_summary` after it. CommandError on a failed run (exit 1) or outputs that cannot be made
+/// (exit 2).
+void run_vio_with_outputs(io::SensorSource& source, const pipeline::VioRunOptions& options,
+                          const pipeline::RunDescription& what, const std::string& out_dir,
+                          const std::function<void()>& extra_summary = {});
+
+}  // namespace dynavins::cli

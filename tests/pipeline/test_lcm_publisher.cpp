@@ -1,0 +1,142 @@
+// LcmPublisher on memq://: what a subscriber receives for each kind of item, the status rule (a change
+// at once, otherwise once a second with the reason of the change), the latency it measures, and the
+// channel-name overrides.
+#include <catch2/catch.hpp>
+#include <lcm/lcm-cpp.hpp>
+
+#include <dynavins_lcm/pipeline_stats_t.hpp>
+#include <dynavins_lcm/pose_t.hpp>
+#include <dynavins_lcm/status_t.hpp>
+#include <dynavins_lcm/weighted_feature_set_t.hpp>
+
+#include <map>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+#include "pipeline/clock.hpp"
+#include "pipeline/lcm_publisher.hpp"
+
+using namespace dynavins;
+using namespace dynavins::pipeline;
+
+namespace {
+
+/// Every message received, decoded by channel.
+struct Recorder {
+  std::map<std::string, int> count;
+  std::vector<dynavins_lcm::pose_t> poses;
+  std::vector<dynavins_lcm::status_t> status;
+  std::vector<dynavins_lcm::weighted_feature_set_t> features;
+  void on(const lcm::ReceiveBuffer* rb, const std::string& ch) {
+    ++count[ch];
+    if (ch == "P" || ch == "P_IMU") {
+      dynavins_lcm::pose_t m;
+      REQUIRE(m.decode(rb->data, 0, static_cast<int>(rb->data_size)) > 0);
+      poses.push_back(m);
+    } else if (ch == "S") {
+      dynavins_lcm::status_t m;
+      REQUIRE(m.decode(rb->data, 0, static_cast<int>(rb->data_size)) > 0);
+      status.push_back(m);
+    } else if (ch == "F") {
+      dynavins_lcm::weighted_feature_set_t m;
+      REQUIRE(m.decode(rb->data, 0, static_cast<int>(rb->data_size)) > 0);
+      features.push_back(m);
+    }
+  }
+};
+
+PublisherChannels testChannels() {
+  PublisherChannels c;
+  for (const char* a : {"pose_imu=P_IMU", "pose=P", "features=F", "status=S", "stats=ST"}) c.set(a);
+  return c;
+}
+
+void drain(lcm::LCM& lcm) {
+  while (lcm.handleTimeout(0) > 0) {
+  }
+}
+
+StatusUpdate status(int64_t t_ns, estimator::EstimatorStatus s, std::string reason = "") {
+  return StatusUpdate{t_ns, s, std::move(reason), 1, 0};
+}
+
+}  // namespace
+
+TEST_CASE("LcmPublisher: each item reaches its channel, decoded as sent", "[lcm_publisher]") {
+  lcm::LCM lcm("memq://");
+  REQUIRE(lcm.good());
+  Recorder rx;
+  lcm.subscribe(".*", &Recorder::on, &rx);
+  LcmPublisher pub(lcm, testChannels());
+
+  NavState s;
+  s.t_ns = 1'000'000'000;
+  s.p_wb = {1, 2, 3};
+  pub.process(PublishItem{steady_now_ns(), PoseEstimate{PoseSource::ImuRate, s}});
+  s.t_ns += 50'000'000;
+  pub.process(PublishItem{steady_now_ns(), PoseEstimate{PoseSource::Window, s}});
+  WeightedFeatureSet set;
+  set.t_ns = s.t_ns;
+  set.features.resize(3);
+  set.features[1].weight = 0.25f;
+  pub.process(PublishItem{0, set});
+  drain(lcm);
+
+  CHECK(rx.count["P_IMU"] == 1);
+  CHECK(rx.count["P"] == 1);
+  REQUIRE(rx.features.size() == 1);
+  CHECK(rx.features[0].num_features == 3);
+  CHECK(rx.features[0].features[1].weight == 0.25f);
+  REQUIRE(rx.poses.size() == 2);
+  CHECK(rx.poses[0].source == dynavins_lcm::pose_t::SOURCE_IMU_RATE);
+  CHECK(rx.poses[1].source == dynavins_lcm::pose_t::SOURCE_WINDOW);
+  CHECK(rx.poses[1].utime == 1'050'000);
+  CHECK(rx.poses[1].position[2] == 3.0);
+
+  const PublisherStats st = pub.stats();
+  CHECK(st.imu_poses == 1);
+  CHECK(st.window_poses == 1);
+  CHECK(st.feature_sets == 1);
+  CHECK(st.imu_pose_latency.count == 1);
+  CHECK(st.window_pose_latency.count == 1);
+  CHECK(st.failed == 0);
+}
+
+TEST_CASE("LcmPublisher: a status change goes out at once, a repeat does not", "[lcm_publisher]") {
+  lcm::LCM lcm("memq://");
+  Recorder rx;
+  lcm.subscribe(".*", &Recorder::on, &rx);
+  LcmPublisher pub(lcm, testChannels(), [] { return RunReport{}; });
+  using estimator::EstimatorStatus;
+  pub.process(PublishItem{0, status(1, EstimatorStatus::Initializing)});
+  pub.process(PublishItem{0, status(2, EstimatorStatus::Initializing)});  // no change: not sent yet
+  pub.process(PublishItem{0, status(3, EstimatorStatus::Tracking, "initialized")});
+  pub.process(PublishItem{0, status(4, EstimatorStatus::Tracking)});
+  pub.process(PublishItem{0, status(5, EstimatorStatus::Reset, "reset: too few features")});
+  drain(lcm);
+  REQUIRE(rx.status.size() == 3);
+  CHECK(rx.status[0].status == dynavins_lcm::status_t::INITIALIZING);
+  CHECK(rx.status[1].status == dynavins_lcm::status_t::TRACKING);
+  CHECK(rx.status[1].reason == "initialized");
+  CHECK(rx.status[2].status == dynavins_lcm::status_t::RESET);
+
+  // The end of the run: the current status with the reason of the change that led to it, and stats.
+  pub.process(PublishItem{0, status(6, EstimatorStatus::Reset)});
+  pub.finish();
+  drain(lcm);
+  REQUIRE(rx.status.size() == 4);
+  CHECK(rx.status[3].utime == 0);  // 6 ns rounds to 0 us
+  CHECK(rx.status[3].reason == "reset: too few features");
+  CHECK(rx.count["ST"] == 1);
+}
+
+TEST_CASE("PublisherChannels: key=NAME overrides; bad keys are named", "[lcm_publisher]") {
+  PublisherChannels c;
+  CHECK(c.pose == "DYNAVINS_POSE");
+  c.set("pose=ROBOT_POSE");
+  CHECK(c.pose == "ROBOT_POSE");
+  CHECK_THROWS_WITH(c.set("posture=X"), Catch::Contains("posture") && Catch::Contains("pose_imu"));
+  CHECK_THROWS_WITH(c.set("pose="), Catch::Contains("key=NAME"));
+  CHECK_THROWS_WITH(c.set("pose"), Catch::Contains("key=NAME"));
+}
