@@ -14,6 +14,8 @@ PACKAGES=(
   libspdlog-dev libcli11-dev catch2
   # LCM: C/C++ library, lcm-gen/lcm-logger/lcm-spy, Java bindings for lcm-spy, a JDK for the types jar
   liblcm-dev liblcm-bin liblcm-java default-jdk-headless
+  # lcm-spy's charts, and a headless X server (+ xwd) for the lcm-spy test and its screenshot
+  libjchart2d-java xvfb x11-apps
   # gzip-compressed trajectory files
   zlib1g-dev
   # network namespace tools for udpm tests (unshare, ip)
