@@ -10,6 +10,8 @@
 
 #include <spdlog/spdlog.h>
 
+#include "stages/loop/graph/pose_graph_4dof.hpp"
+
 namespace dynavins::loop {
 
 namespace {
@@ -131,7 +133,8 @@ void LoopCloser::run_optimization(LoopCloserOutput& out) {
   out.timing.optimization_ms = ms_since(t0);
   out.optimized = true;
   ++num_optimizations_;
-  corrected_ = last_result_.poses;
+  corrected_ = options_.refine_adopted && options_.mode == LoopMode::Dynavins ? refine_with_adopted(last_result_)
+                                                                              : last_result_.poses;
   drift_ = drift_correction(odometry_.back(), corrected_.back());
   out.keyframe_t_ns = t_ns_;
   out.corrected = corrected_;
@@ -151,6 +154,24 @@ void LoopCloser::run_optimization(LoopCloserOutput& out) {
   spdlog::debug("loop closer: {} optimisation over {} keyframes, {} loops, {} groups: {:.1f} ms",
                 loop_mode_name(options_.mode), t_ns_.size(), optimizer_.loops().size(), optimizer_.groups().size(),
                 out.timing.optimization_ms);
+}
+
+std::vector<RigidPose> LoopCloser::refine_with_adopted(const LoopGraphResult& result) const {
+  auto node_of = [&](int64_t t) {
+    return static_cast<int>(std::lower_bound(t_ns_.begin(), t_ns_.end(), t) - t_ns_.begin());
+  };
+  std::vector<LoopEdge> edges;
+  const std::vector<VerifiedLoop>& loops = optimizer_.loops();
+  for (const LoopResult& r : result.loops) {
+    if (!r.used || r.weight < options_.adopt_min_weight) continue;
+    const VerifiedLoop& l = loops[r.loop_index];
+    edges.push_back(
+        LoopEdge{node_of(l.match_t_ns), node_of(l.query_t_ns), RigidPose{l.p_mq, l.q_mq.normalized()}, 1.0});
+  }
+  if (edges.empty()) return result.poses;
+  PoseGraph4Dof graph(odometry_, options_.graph.graph);
+  graph.solve(edges, LoopEdgeLoss::Huber);
+  return graph.poses();
 }
 
 std::vector<KeyframeCorrection> LoopCloser::keyframe_corrections() const {

@@ -48,6 +48,14 @@ struct LoopCloserOptions {
   /// descriptors still serve the bag of words and as query points).
   bool use_point_weights = true;
   float min_point_weight = 0.5f;
+  /// Not in the paper: after a Dynavins optimisation, solve the pose graph once more from the odometry with
+  /// the loops of the adopted hypotheses (final weight >= adopt_min_weight) as plain unit-weight loop edges
+  /// (Huber, as LoopMode::All) and every other loop left out. Eq. 16 scales each loop residual by w/|H|,
+  /// so a group's |H| loops together pull like w^2/|H| of one loop edge; with the ~50 loops per group of
+  /// a forward-moving camera (3 candidates per keyframe) the correction then stays partial (measured in
+  /// tests/loop/test_loop_closer.cpp). The weights and hypotheses stay those of eq. 16. Off by default.
+  bool refine_adopted = false;
+  double adopt_min_weight = 0.5;
 };
 
 /// A loop verified at this keyframe. The group index is known only once the group closes (kept groups);
@@ -130,6 +138,7 @@ class LoopCloser {
  private:
   LoopCloserOutput process(KeyframeDescriptors d, double descriptors_ms);
   void run_optimization(LoopCloserOutput& out);
+  std::vector<RigidPose> refine_with_adopted(const LoopGraphResult& result) const;
 
   std::shared_ptr<const VocabularyTree> vocabulary_;
   LoopCloserOptions options_;
