@@ -6,6 +6,10 @@
 // vocabulary is trained on them. Optionally a "temporarily static object" (a parked bus: a plane of points
 // with their own descriptors, occluding what is behind it) stands at place A on lap 1 and 2.5 m further on
 // lap 2.
+// Measured (Release): 240 verified loops, all true (worst T_m^k error 0.023 m), every lap-2 keyframe past the
+// first half side closes one; RMSE odometry 1.09 m -> all 0.12, switchable 0.12, dynavins 0.38 m (eq. 16's
+// w/|H| on ~50 loops per group), dynavins + refine_adopted 0.15 m. With the bus: 8 false loops (2.5 m off),
+// all 0.21 m, dynavins 0.37 m with the false hypothesis at w < 0.001, switchable 0.13 m. 22 kB per keyframe.
 #include <algorithm>
 #include <cmath>
 #include <map>
@@ -164,6 +168,7 @@ struct Run {
   std::size_t memory_bytes = 0;
   double max_keyframe_ms = 0.0;
   std::vector<KeyframeCorrection> corrections;
+  std::vector<NewLoop> new_loops;  // as the per-keyframe outputs reported them
 };
 
 Run run(const World& w, const std::shared_ptr<const VocabularyTree>& vocab, LoopMode mode,
@@ -176,6 +181,7 @@ Run run(const World& w, const std::shared_ptr<const VocabularyTree>& vocab, Loop
     const double ms = out.timing.query_ms + out.timing.verification_ms + out.timing.optimization_ms;
     r.max_keyframe_ms = std::max(r.max_keyframe_ms, ms);
     r.hypotheses.insert(r.hypotheses.end(), out.hypotheses.begin(), out.hypotheses.end());
+    r.new_loops.insert(r.new_loops.end(), out.new_loops.begin(), out.new_loops.end());
   }
   const LoopCloserOutput fin = lc.finish();
   r.hypotheses.insert(r.hypotheses.end(), fin.hypotheses.begin(), fin.hypotheses.end());
@@ -225,6 +231,12 @@ TEST_CASE("LoopCloser: true revisits are detected and verified", "[loop][closer]
     worst = std::max(worst, loop_error_m(w.s, l));
   }
   CHECK(worst < 0.05);
+  // Candidates are older than the query group's first keyframe (m < i) and outside the last 30 keyframes.
+  REQUIRE(r.new_loops.size() == r.loops.size());
+  for (const NewLoop& nl : r.new_loops) {
+    CHECK(nl.loop.match_t_ns < nl.group_first_t_ns);
+    CHECK(index_of(w.s, nl.loop.query_t_ns) - index_of(w.s, nl.loop.match_t_ns) > 30);
+  }
   // Nearly every lap-2 keyframe (after the first half side, whose C_m would be within the exclusion) closes a loop.
   CHECK(lap2_recall(w.s, r.loops) > 0.9);
   // Groups form on the persistent feature ids: one per side of the square (the corners break the tracks).
@@ -246,6 +258,9 @@ TEST_CASE("LoopCloser: off keeps the odometry, all and dynavins remove most of t
   CHECK(odom > 1.0);
   CHECK(w.s.rmse(all.poses) < 0.2 * odom);
   CHECK(w.s.rmse(dyn.poses) < 0.45 * odom);
+  const Run sw = run(w, vocab, LoopMode::Switchable);
+  WARN("RMSE switchable " << w.s.rmse(sw.poses) << " m");
+  CHECK(w.s.rmse(sw.poses) < 0.45 * odom);
   CHECK(w.s.end_error(all.poses) < 0.3 * w.s.end_error(w.s.odom));
   CHECK(w.s.end_error(dyn.poses) < 0.5 * w.s.end_error(w.s.odom));
 }
@@ -263,7 +278,8 @@ std::vector<std::size_t> false_loops(const World& w, const Run& r) {
 TEST_CASE("LoopCloser: a relocated object gives false loops that bend `all`", "[loop][closer]") {
   const World clean = make_world(), bus = make_world(WorldOptions{true});
   const Run a_clean = run(clean, train_vocabulary(clean), LoopMode::All);
-  const Run a_bus = run(bus, train_vocabulary(bus), LoopMode::All);
+  const auto bus_vocab = train_vocabulary(bus);
+  const Run a_bus = run(bus, bus_vocab, LoopMode::All);
   const std::vector<std::size_t> f = false_loops(bus, a_bus);
   WARN("false loops " << f.size() << " of " << a_bus.loops.size() << "; RMSE all: clean " << clean.s.rmse(a_clean.poses)
                       << " m, with the bus " << bus.s.rmse(a_bus.poses) << " m");
@@ -271,6 +287,12 @@ TEST_CASE("LoopCloser: a relocated object gives false loops that bend `all`", "[
   CHECK(f.size() >= 5);
   for (std::size_t l : f) CHECK(std::abs(loop_error_m(bus.s, a_bus.loops[l]) - 2.5) < 0.8);  // the bus' shift
   CHECK(bus.s.rmse(a_bus.poses) > clean.s.rmse(a_clean.poses) + 0.05);
+  // For reference (no claim): switchable constraints on the same loops.
+  const Run s_bus = run(bus, bus_vocab, LoopMode::Switchable);
+  int false_switched_off = 0;
+  for (std::size_t l : f) false_switched_off += s_bus.result.loops[l].weight < 0.5 ? 1 : 0;
+  WARN("RMSE switchable with the bus " << bus.s.rmse(s_bus.poses)
+                                       << " m; false loops with s < 0.5: " << false_switched_off << " of " << f.size());
 }
 
 TEST_CASE("LoopCloser: dynavins gives the relocated object's hypothesis a low weight", "[loop][closer]") {
@@ -318,6 +340,30 @@ TEST_CASE("LoopCloser: refine_adopted re-solves with the adopted hypotheses' loo
   CHECK(e_clean < 0.2);
   CHECK(std::abs(e_bus - e_clean) < 0.03);
   for (std::size_t l : false_loops(bus, r_bus)) CHECK(r_bus.result.loops[l].weight < 0.05);
+}
+
+TEST_CASE("LoopCloser: a camera standing still finds loops only outside its recent keyframes and group",
+          "[loop][closer]") {
+  const World w = make_world();
+  LoopCloserOptions opts;
+  opts.mode = LoopMode::All;
+  LoopCloser lc(train_vocabulary(w), opts);
+  std::vector<NewLoop> loops;
+  for (int k = 0; k < 40; ++k) {  // the same view and feature ids: groups of 20 (max_group_size)
+    KeyframeDescriptors kd = w.keyframes[10];
+    kd.t_ns = w.s.t_ns[static_cast<std::size_t>(k)];
+    const LoopCloserOutput out = lc.add_descriptors(kd);
+    for (const NewLoop& nl : out.new_loops) {
+      // Keyframe k (in the group starting at 20) may match m <= min(19, k - 31) only.
+      const auto m = static_cast<int>(index_of(w.s, nl.loop.match_t_ns));
+      CHECK(k >= 31);
+      CHECK(m <= std::min(19, k - 31));
+      CHECK(nl.loop.p_mq.norm() < 0.05);
+      loops.push_back(nl);
+    }
+  }
+  CHECK(!loops.empty());
+  CHECK(lc.groups().size() == 1);  // the second group is still open
 }
 
 TEST_CASE("LoopCloser: low-weight points are not used as the candidate's 3-D points", "[loop][closer]") {
