@@ -117,6 +117,9 @@ RunRow load_run(const std::string& dir, const eval::Trajectory& gt, const Compar
   r.tracking = json_number(json, "frames_tracking", sum.string());
   r.estimated = json_number(json, "frames_estimated", sum.string());
   r.ba = json_raw(json, "ba").value_or("?");
+  // A run that failed or was interrupted is listed as such, never as a normal one.
+  if (json_raw(json, "ok").value_or("true") == "false") r.name += " (FAILED)";
+  else if (json_raw(json, "interrupted").value_or("false") == "true") r.name += " (interrupted)";
   r.cameras = json_raw(json, "cameras").value_or("?");
 
   eval::Trajectory est;

@@ -65,7 +65,7 @@ void live(const LiveCommandOptions& o) {
   }
   spdlog::info("live: listening on {} ({}, {}), publishing on {}; Ctrl-C ends the run and writes {}", input_url,
                in.stereo_channel, in.imu_channel, opt.lcm_url, out_dir);
-  run_vio_with_outputs(*source, opt, what, out_dir, [&] {
+  run_vio_with_outputs(*source, opt, what, out_dir, InterruptIs::NormalEnd, [&] {
     const auto& s = source->stats();
     std::printf("live input  %lld frames, %lld IMU samples, %lld ground-truth states; rejected: %lld of another type, "
                 "%lld undecodable, %lld bad images, %lld bad IMU, %lld going back in time\n",

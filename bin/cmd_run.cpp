@@ -55,7 +55,7 @@ void run(const RunCommandOptions& o) {
                opt.gyro_prediction ? "on" : "off", out_dir);
 
   auto source = o.input.open(/*need_stereo=*/opt.mode.stereo);
-  run_vio_with_outputs(*source, opt, what, out_dir);
+  run_vio_with_outputs(*source, opt, what, out_dir, InterruptIs::Failure);
 }
 
 }  // namespace

@@ -6,6 +6,7 @@
 #include <utility>
 
 #include <CLI/CLI.hpp>
+#include <fmt/format.h>
 #include <spdlog/spdlog.h>
 
 #include "bin/commands.hpp"
@@ -94,7 +95,7 @@ void print_summary(const pipeline::VioRunResult& r, const pipeline::RunOutputs& 
 
 void run_vio_with_outputs(io::SensorSource& source, const pipeline::VioRunOptions& opt,
                           const pipeline::RunDescription& what, const std::string& out_dir,
-                          const std::function<void()>& extra_summary) {
+                          InterruptIs interrupt, const std::function<void()>& extra_summary) {
   std::unique_ptr<pipeline::RunOutputs> outputs;
   try {
     outputs = std::make_unique<pipeline::RunOutputs>(out_dir);
@@ -115,9 +116,23 @@ void run_vio_with_outputs(io::SensorSource& source, const pipeline::VioRunOption
                            " (outputs left as .partial in " + out_dir + ")",
                        1);
   }
+  // A run that produced no pose did not succeed, whatever its threads say: an empty log, IMU that never
+  // overlaps the images, a scene the estimator never initialised on.
+  const bool no_pose = r.frames_tracking == 0;
+  if (no_pose) {
+    r.report.ok = false;
+    r.report.error = "no pose was estimated (" + std::to_string(r.replay.frames) + " frames in, " +
+                     std::to_string(r.frames_estimated) + " estimated, none tracking)";
+  }
   outputs->complete(r, what);
   print_summary(r, *outputs, out_dir);
   if (extra_summary) extra_summary();
+  if (no_pose) throw CommandError(r.report.error + "; summary in " + out_dir + "/summary.json says ok: false", 1);
+  if (r.interrupted() && interrupt == InterruptIs::Failure)
+    throw CommandError(fmt::format("interrupted: the outputs in {} cover {:.1f} s of data only (summary.json says "
+                                   "interrupted: true)",
+                                   out_dir, r.replay.sensor_s),
+                       130);
 }
 
 }  // namespace dynavins::cli

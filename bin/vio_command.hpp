@@ -34,11 +34,15 @@ struct VioCommandOptions {
   pipeline::VioRunOptions load(double rate) const;
 };
 
+/// What SIGINT means: for `run` the recording was not processed to its end (exit 130 after the outputs
+/// are written, marked interrupted); for `live` it is how a run ends.
+enum class InterruptIs { Failure, NormalEnd };
+
 /// Runs `source` into `out_dir` (odometry, features, events, summary.json), prints the summary and, if
-/// given, `extra_summary` after it. CommandError on a failed run (exit 1) or outputs that cannot be made
-/// (exit 2).
+/// given, `extra_summary` after it. CommandError on a failed run or one that estimated no pose (exit 1,
+/// summary ok: false), outputs that cannot be made (exit 2), or an interrupt that is a failure (130).
 void run_vio_with_outputs(io::SensorSource& source, const pipeline::VioRunOptions& options,
-                          const pipeline::RunDescription& what, const std::string& out_dir,
+                          const pipeline::RunDescription& what, const std::string& out_dir, InterruptIs interrupt,
                           const std::function<void()>& extra_summary = {});
 
 }  // namespace dynavins::cli
