@@ -47,7 +47,8 @@ int imagesHeldElsewhere(const ClipRun& run) {
   return n;
 }
 
-ClipRun runClip() {
+/// With `drop_imu_at` >= 0, that frame comes without its IMU interval (an outage: the estimator resets).
+ClipRun runClip(int drop_imu_at = -1) {
   ClipRun run;
   run.options = EstimatorOptions::load(kConfig);
   run.options.max_solver_time = 1e9;  // iteration budget only: the run must not depend on the machine
@@ -83,7 +84,7 @@ ClipRun runClip() {
     TrackedFrame tf = tracker.process(sf);
     sf = StereoFrame{};  // the images now live in run.left and wherever the tracked frame put them
     const PreintegratedInterval* iv = nullptr;
-    if (prev_t >= 0) {
+    if (prev_t >= 0 && static_cast<int>(run.estimates.size()) != drop_imu_at) {
       auto it = intervals.find(prev_t);
       if (it == intervals.end()) break;  // the clip's IMU ends before this frame
       iv = &it->second;
@@ -220,4 +221,22 @@ TEST_CASE("the estimator holds left images only while their frames are in the wi
   CHECK(run.max_images_held <= run.options.window_size + 2);
   CHECK(run.max_images_held >= run.options.window_size);
   WARN("left images held by the estimator at most: " << run.max_images_held);
+}
+
+TEST_CASE("a reset found before the solve hands out the window's keyframes with the Reset estimate",
+          "[estimator][keyframes]") {
+  const ClipRun run = runClip(60);
+  REQUIRE(run.estimates.at(59).status == EstimatorStatus::Tracking);
+  REQUIRE(run.estimates.at(60).status == EstimatorStatus::Reset);
+  // The window's keyframes (all but its newest frame, estimate 59) with the poses of the last Tracking solve.
+  REQUIRE(run.finished_per_estimate.at(60) == run.options.window_size - 1);
+  REQUIRE(run.finished.size() == static_cast<std::size_t>(run.options.window_size - 1));
+  for (std::size_t k = 0; k < run.finished.size(); ++k) {
+    if (k > 0) CHECK(run.finished[k].t_ns > run.finished[k - 1].t_ns);
+    CHECK(run.finished[k].t_ns < run.estimates[59].t_ns);
+    CHECK(!run.finished[k].image.empty());
+    CHECK(!run.finished[k].points.empty());
+  }
+  // The window filled again after the reset: what is flushed at the end is newer than the reset.
+  for (const Keyframe& kf : run.flushed) CHECK(kf.t_ns > run.estimates[60].t_ns);
 }
