@@ -27,5 +27,6 @@ void add_sim_command(CLI::App& app);
 void add_run_command(CLI::App& app);
 void add_compare_command(CLI::App& app);
 void add_overlay_command(CLI::App& app);
+void add_vocab_command(CLI::App& app);
 
 }  // namespace dynavins::cli

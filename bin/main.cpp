@@ -31,6 +31,7 @@ int main(int argc, char** argv) {
   dynavins::cli::add_run_command(app);
   dynavins::cli::add_compare_command(app);
   dynavins::cli::add_overlay_command(app);
+  dynavins::cli::add_vocab_command(app);
 
   try {
     app.parse(argc, argv);
