@@ -6,7 +6,7 @@ TSAN_BUILD ?= build-tsan
 CMAKE_GEN  := -G Ninja
 CTEST_J    ?= 2
 
-.PHONY: all deps build demo bench bench-quick test test-unit test-tsan lint format-check clean
+.PHONY: all deps build demo bench bench-quick test test-unit test-tsan lint format-check vocab vocab-check clean
 
 all: build
 
@@ -70,6 +70,17 @@ format-check:
 	@out=$$(git clang-format --diff --extensions cpp,hpp main); \
 	  if echo "$$out" | grep -q '^diff'; then echo "$$out"; exit 1; fi; \
 	  echo "format-check: lines changed against main are formatted"
+
+# The default loop-closure vocabulary shipped in git (data/vocabulary/default_vocabulary.bin): the real
+# EuRoC clip of ../shared plus two freshly rendered simulator scenes (scripts/build-vocabulary.sh, ~1 min).
+# vocab-check rebuilds it into a temporary file and compares the bytes with the shipped one.
+vocab: build
+	DYNAVINS=$(BUILD)/bin/dynavins ./scripts/build-vocabulary.sh data/vocabulary/default_vocabulary.bin
+
+vocab-check: build
+	@tmp=$$(mktemp); DYNAVINS=$(BUILD)/bin/dynavins ./scripts/build-vocabulary.sh $$tmp && \
+	  cmp $$tmp data/vocabulary/default_vocabulary.bin && echo "vocab-check: the shipped vocabulary rebuilds byte for byte"; \
+	  rc=$$?; rm -f $$tmp; exit $$rc
 
 clean:
 	rm -rf $(BUILD) $(TSAN_BUILD)

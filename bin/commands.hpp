@@ -29,5 +29,6 @@ void add_compare_command(CLI::App& app);
 void add_overlay_command(CLI::App& app);
 void add_decode_command(CLI::App& app);
 void add_live_command(CLI::App& app);
+void add_vocab_command(CLI::App& app);
 
 }  // namespace dynavins::cli

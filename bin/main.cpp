@@ -33,6 +33,7 @@ int main(int argc, char** argv) {
   dynavins::cli::add_overlay_command(app);
   dynavins::cli::add_decode_command(app);
   dynavins::cli::add_live_command(app);
+  dynavins::cli::add_vocab_command(app);
 
   try {
     app.parse(argc, argv);

@@ -5,6 +5,7 @@
 #include <vector>
 
 #include <Eigen/Core>
+#include <opencv2/core/mat.hpp>
 
 namespace dynavins {
 
@@ -45,6 +46,7 @@ struct TrackedFrame {
   std::vector<TrackedFeature> features;
   TrackerStats stats;
   int64_t received_ns = 0;  ///< steady clock when the tracker took the frame (latency accounting only)
+  cv::Mat image;  // left image (shallow copy), for keyframes
 };
 
 }  // namespace dynavins

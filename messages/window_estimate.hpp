@@ -5,8 +5,10 @@
 
 #include <cstdint>
 #include <string>
+#include <vector>
 
 #include "messages/estimate_messages.hpp"
+#include "messages/keyframe.hpp"
 
 namespace dynavins::estimator {
 
@@ -38,6 +40,10 @@ struct WindowEstimate {
   SolveStats solve;
   std::string event;  ///< "initialized", "reset: <reason>", or empty
   int64_t received_ns = 0;  ///< the frame's TrackedFrame::received_ns (latency accounting only)
+  /// Keyframes that left the window on this frame (loop closer input), oldest first: the oldest keyframe
+  /// when it is marginalised (keyframe == true while Tracking), or, on a Reset found before this frame's
+  /// solve (IMU missing or gapped), every keyframe the window held (see SlidingWindowEstimator).
+  std::vector<Keyframe> finished_keyframes;  // keyframes that left the window on this frame (loop closer input)
 };
 
 }  // namespace dynavins::estimator

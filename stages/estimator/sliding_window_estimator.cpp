@@ -1,6 +1,7 @@
 #include "stages/estimator/sliding_window_estimator.hpp"
 
 #include <chrono>
+#include <climits>
 #include <cmath>
 
 #include <opencv2/calib3d.hpp>
@@ -61,7 +62,8 @@ Eigen::Isometry3d extrinsicOf(const std::array<double, kPoseSize>& e) {
 
 struct SlidingWindowEstimator::Impl {
   Impl(const EstimatorOptions& o, EstimatorMode m)
-      : opt(o), mode(m), W(o.window_size), state(o.window_size), optimizer(solveOptions(o, m)) {
+      : opt(o), mode(m), W(o.window_size), state(o.window_size), optimizer(solveOptions(o, m)),
+        slot_seq(o.window_size + 1, 0), slot_image(o.window_size + 1) {
     if (m.stereo && o.num_of_cam < 2) throw std::invalid_argument("stereo mode needs num_of_cam: 2 in " + o.config_file);
     for (int c = 0; c < std::min<int>(2, static_cast<int>(o.body_T_cam.size())); ++c) {
       const Eigen::Quaterniond q(o.body_T_cam[c].linear());
@@ -81,6 +83,9 @@ struct SlidingWindowEstimator::Impl {
   std::string failureReason(const Eigen::Vector3d& last_p, const Eigen::Quaterniond& last_q);
   void slide(bool keep_second_newest);
   void fillOutput(WindowEstimate& e);
+  Keyframe makeKeyframe(int slot) const;
+  /// Appends the keyframes of slots [0, end) not handed out yet (time order).
+  void emitKeyframes(int end, std::vector<Keyframe>& out);
   SlotCameraPose cams() const {
     return [this](int k) { return state.camera(k, 0); };
   }
@@ -96,6 +101,10 @@ struct SlidingWindowEstimator::Impl {
   bool tracking = false;
   bool gravity_aligned = false;
   std::string last_init_failure;  ///< last reason initialisation failed, logged when it changes
+  // Per slot, moved with the slot (slide): the tracked frame's seq and left image (shallow), for keyframes.
+  std::vector<int64_t> slot_seq;
+  std::vector<cv::Mat> slot_image;
+  int64_t last_emitted_t_ns = INT64_MIN;  ///< newest keyframe handed out (each goes out once)
 };
 
 void SlidingWindowEstimator::Impl::resetAll() {
@@ -104,6 +113,7 @@ void SlidingWindowEstimator::Impl::resetAll() {
   state.extrinsic = extrinsic;
   features.clear();
   optimizer.reset();
+  for (cv::Mat& m : slot_image) m.release();
   newest = -1;
   tracking = false;
   gravity_aligned = false;
@@ -270,7 +280,11 @@ void SlidingWindowEstimator::Impl::slide(bool keep_second_newest) {
   if (keep_second_newest) {
     if (tracking) optimizer.marginalizeOldest(state, newest, features);
     features.removeOldest(cams());
-    for (int k = 0; k < newest; ++k) state.moveSlot(k + 1, k);
+    for (int k = 0; k < newest; ++k) {
+      state.moveSlot(k + 1, k);
+      slot_seq[k] = slot_seq[k + 1];
+      slot_image[k] = std::move(slot_image[k + 1]);  // the oldest's image is released here
+    }
     state.preint[0].reset();
   } else {
     if (tracking) optimizer.marginalizeSecondNewest(state, newest);
@@ -282,6 +296,8 @@ void SlidingWindowEstimator::Impl::slide(bool keep_second_newest) {
     auto keep = std::move(state.preint[newest - 1]);
     state.moveSlot(newest, newest - 1);
     state.preint[newest - 1] = std::move(keep);
+    slot_seq[newest - 1] = slot_seq[newest];
+    slot_image[newest - 1] = std::move(slot_image[newest]);  // the dropped frame's image is released here
   }
   state.preint[newest].reset();
   --newest;
@@ -317,6 +333,42 @@ void SlidingWindowEstimator::Impl::fillOutput(WindowEstimate& e) {
   }
 }
 
+Keyframe SlidingWindowEstimator::Impl::makeKeyframe(int slot) const {
+  Keyframe kf;
+  kf.t_ns = state.t_ns[slot];
+  kf.seq = slot_seq[slot];
+  kf.p_wb = state.p(slot);
+  kf.q_wb = state.q(slot);
+  const auto& e = state.extrinsic[0];
+  kf.p_bc = Eigen::Vector3d(e[0], e[1], e[2]);
+  kf.q_bc = Eigen::Quaterniond(e[6], e[3], e[4], e[5]);
+  kf.image = slot_image[slot];  // shallow copy
+  for (const auto& [id, f] : features.all()) {
+    if (f.start_slot > slot || f.endSlot() < slot) continue;
+    const FeatureObservation& o = f.obs[slot - f.start_slot];
+    KeyframePoint p;
+    p.id = id;
+    p.px = o.px;
+    p.xy = o.xy;
+    if (f.has_depth && f.inv_depth > 0) {
+      const CameraPose a = state.camera(f.start_slot, 0);
+      p.p_w = a.R * (Eigen::Vector3d(f.obs[0].xy.x(), f.obs[0].xy.y(), 1.0) / f.inv_depth) + a.p;
+      p.has_p_w = true;
+    }
+    p.weight = static_cast<float>(mode.loss == BaLoss::Dynavins ? f.weight : 1.0);
+    kf.points.push_back(p);
+  }
+  return kf;
+}
+
+void SlidingWindowEstimator::Impl::emitKeyframes(int end, std::vector<Keyframe>& out) {
+  for (int k = 0; k < end; ++k) {
+    if (state.t_ns[k] <= last_emitted_t_ns) continue;
+    out.push_back(makeKeyframe(k));
+    last_emitted_t_ns = state.t_ns[k];
+  }
+}
+
 WindowEstimate SlidingWindowEstimator::Impl::process(const TrackedFrame& frame, const PreintegratedInterval* imu) {
   const auto t0 = Clock::now();
   WindowEstimate e;
@@ -326,27 +378,32 @@ WindowEstimate SlidingWindowEstimator::Impl::process(const TrackedFrame& frame, 
     out.solve.total_ms = std::chrono::duration<double, std::milli>(Clock::now() - t0).count();
     return out;
   };
-  auto fail = [&](const std::string& why) -> WindowEstimate {
+  // `latest_slot`: the slot of the latest frame before this one when the failure came before the solve
+  // (slots below it are keyframes with the last Tracking poses: handed out), -1 after the solve (dropped).
+  auto fail = [&](const std::string& why, int latest_slot) -> WindowEstimate {
     spdlog::warn("estimator reset at t={:.3f} s: {}", frame.t_ns * 1e-9, why);
     const bool was_tracking = tracking;
+    if (was_tracking && latest_slot > 0) emitKeyframes(latest_slot, e.finished_keyframes);
     resetAll();
     e.status = was_tracking ? EstimatorStatus::Reset : EstimatorStatus::Initializing;
     e.event = "reset: " + why;
     return finish(e);
   };
 
-  if (newest >= 0 && imu == nullptr) return fail("no IMU between frames");
+  if (newest >= 0 && imu == nullptr) return fail("no IMU between frames", newest);
   if (imu && imu->has_gap && imu->max_gap_ns > std::llround(opt.imu_max_gap * 1e9)) {
-    return fail("IMU gap of " + std::to_string(imu->max_gap_ns / 1'000'000) + " ms");
+    return fail("IMU gap of " + std::to_string(imu->max_gap_ns / 1'000'000) + " ms", newest);
   }
   if (imu && imu->has_gap) e.event = "imu gap of " + std::to_string(imu->max_gap_ns / 1'000'000) + " ms bridged";
 
   // Place the frame in the next slot, with its IMU-predicted state.
   ++newest;
   state.t_ns[newest] = frame.t_ns;
+  slot_seq[newest] = frame.seq;
+  slot_image[newest] = frame.image;  // shallow copy, released when the frame leaves the window
   if (newest > 0) {
     std::string why;
-    if (!predictNewest(*imu, &why)) return fail(why);
+    if (!predictNewest(*imu, &why)) return fail(why, newest - 1);
   }
   const Eigen::Vector3d last_p = newest > 0 ? Eigen::Vector3d(state.p(newest - 1)) : Eigen::Vector3d::Zero();
   const Eigen::Quaterniond last_q = newest > 0 ? state.q(newest - 1) : Eigen::Quaterniond::Identity();
@@ -387,7 +444,7 @@ WindowEstimate SlidingWindowEstimator::Impl::process(const TrackedFrame& frame, 
     e.solve = optimizer.solve(state, newest, features);
     features.removeBadDepths();
     const std::string why = failureReason(last_p, last_q);
-    if (!why.empty()) return fail(why);
+    if (!why.empty()) return fail(why, -1);
   }
   spdlog::debug("t={:.3f} p=({:.3f},{:.3f},{:.3f}) v=({:.3f},{:.3f},{:.3f}) ba={:.3f} bg={:.4f} ba_ms={:.1f} it={} alt={} feats={} kf={} still={}",
                 frame.t_ns * 1e-9, state.p(newest).x(), state.p(newest).y(), state.p(newest).z(), state.v(newest).x(),
@@ -396,6 +453,8 @@ WindowEstimate SlidingWindowEstimator::Impl::process(const TrackedFrame& frame, 
                 e.standstill);
   e.keyframe = keep_second_newest;
   fillOutput(e);
+  // The oldest keyframe leaves the window now, with its final pose and the features before they go.
+  if (keep_second_newest) emitKeyframes(1, e.finished_keyframes);
   const auto t_m = Clock::now();
   slide(keep_second_newest);
   e.solve.marginalization_ms = std::chrono::duration<double, std::milli>(Clock::now() - t_m).count();
@@ -425,6 +484,13 @@ NavState SlidingWindowEstimator::latestState() const {
   s.bias_acc = Eigen::Map<const Eigen::Vector3d>(m.state.speed_bias[k].data() + 3);
   s.bias_gyr = Eigen::Map<const Eigen::Vector3d>(m.state.speed_bias[k].data() + 6);
   return s;
+}
+
+std::vector<Keyframe> SlidingWindowEstimator::flushKeyframes() {
+  std::vector<Keyframe> out;
+  Impl& m = *impl_;
+  if (m.tracking && m.newest > 0) m.emitKeyframes(m.newest, out);
+  return out;
 }
 
 bool SlidingWindowEstimator::tracking() const { return impl_->tracking; }

@@ -4,9 +4,11 @@
 // frame in, one WindowEstimate out. No threads.
 
 #include <memory>
+#include <vector>
 
 #include "stages/common/estimator_options.hpp"
 #include "stages/estimator/ba_mode.hpp"
+#include "messages/keyframe.hpp"
 #include "messages/window_estimate.hpp"
 #include "messages/tracked_frame.hpp"
 #include "messages/preintegrated_interval.hpp"
@@ -19,6 +21,15 @@ struct EstimatorMode {
   bool stereo = true;  ///< use the right camera (needs num_of_cam == 2)
 };
 
+/// Keyframes for the loop closer (paper IV, DESIGN.md §2): every frame the window kept is handed out once,
+/// as a dynavins::Keyframe with its final window pose, when it leaves the window as the marginalised
+/// oldest keyframe (WindowEstimate::finished_keyframes), or at the end of the run (flushKeyframes()).
+/// Its points are the window features it observed (p_w from the feature's current depth, when it has one;
+/// weight w_j, 1 under huber), its image the tracked frame's left image (shallow: the window holds one
+/// image reference per slot, released when the frame leaves). Only frames whose pose is tracking-valid
+/// are handed out. On a reset: a failure found before the frame's solve (IMU missing, gapped or not
+/// continuous) emits the window's keyframes with the Reset estimate (their poses are the last Tracking
+/// solve's); a failure found by the solve's own checks drops them (every slot comes from the failed solve).
 class SlidingWindowEstimator {
  public:
   SlidingWindowEstimator(const EstimatorOptions& options, EstimatorMode mode);
@@ -32,6 +43,10 @@ class SlidingWindowEstimator {
 
   /// The newest frame's state (for IMU-rate propagation); valid once tracking.
   NavState latestState() const;
+  /// The keyframes still in the window (every slot but the newest frame, which no keyframe decision has
+  /// kept yet), oldest first, none already handed out; empty unless tracking. For the end of the run: a
+  /// later process() does not hand them out again.
+  std::vector<Keyframe> flushKeyframes();
   bool tracking() const;
 
  private:

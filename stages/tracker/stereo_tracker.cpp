@@ -364,6 +364,7 @@ TrackedFrame StereoTracker::process(const StereoFrame& frame, std::optional<Eige
   TrackedFrame out;
   out.t_ns = frame.t_ns;
   out.seq = frame.seq;
+  out.image = frame.left;  // shallow: the estimator keeps it while the frame is in its window (keyframes)
 
   pyramid(left, &curr_pyr_);
   const Pyramid& curr = curr_pyr_;
