@@ -1,6 +1,7 @@
 #include "bin/vio_command.hpp"
 
 #include <algorithm>
+#include <filesystem>
 #include <cstdio>
 #include <memory>
 #include <utility>
@@ -12,6 +13,7 @@
 #include "bin/commands.hpp"
 #include "pipeline/report_format.hpp"
 #include "stages/estimator/ba_mode.hpp"
+#include "stages/loop/graph/loop_mode.hpp"
 
 namespace dynavins::cli {
 
@@ -28,6 +30,12 @@ void VioCommandOptions::add_options(CLI::App& cmd, const std::string& lcm_url_he
       ->check(CLI::Range(1.0, 100000.0))
       ->capture_default_str();
   cmd.add_option("--lcm-url", lcm_url, lcm_url_help);
+  cmd.add_option("--loop", loop,
+                 "Loop closure: off (odometry only), all (every verified loop, Huber), switchable (switchable "
+                 "constraints), dynavins (selective optimisation of grouped hypotheses, paper IV)")
+      ->check(CLI::IsMember({"off", "all", "switchable", "dynavins"}))
+      ->capture_default_str();
+  cmd.add_option("--vocabulary", vocabulary, "Vocabulary tree for place recognition (default: the shipped one)");
   cmd.add_option("--channel", channels,
                  "Rename an output channel: --channel key=NAME (keys: pose_imu, pose, features, status, stats)");
 }
@@ -45,11 +53,28 @@ pipeline::VioRunOptions VioCommandOptions::load(double rate) const {
     opt.gyro_prediction = gyro_prediction;
     opt.lcm_url = lcm_url;
     for (const std::string& c : channels) opt.channels.set(c);
+    opt.loop_mode = loop::parse_loop_mode(loop);
+    if (opt.loop_mode != loop::LoopMode::Off) {
+      opt.vocabulary = vocabulary.empty() ? default_vocabulary_path() : vocabulary;
+      if (!std::filesystem::is_regular_file(opt.vocabulary))
+        throw std::invalid_argument("--vocabulary " + opt.vocabulary + ": no such file (or --loop off)");
+    }
     pipeline::checkVioOptions(opt);
   } catch (const std::exception& e) {
     throw CommandError(e.what(), 2);
   }
   return opt;
+}
+
+std::string default_vocabulary_path() {
+  namespace fs = std::filesystem;
+  std::error_code ec;
+  const fs::path exe = fs::read_symlink("/proc/self/exe", ec);
+  if (!ec) {
+    const fs::path installed = exe.parent_path().parent_path() / "share/dynavins/default_vocabulary.bin";
+    if (fs::is_regular_file(installed)) return installed.string();
+  }
+  return std::string(DYNAVINS_SOURCE_DIR) + "/data/vocabulary/default_vocabulary.bin";
 }
 
 namespace {
@@ -83,9 +108,18 @@ void print_summary(const pipeline::VioRunResult& r, const pipeline::RunOutputs& 
                 static_cast<long long>(r.publisher->window_poses), static_cast<long long>(r.publisher->feature_sets),
                 static_cast<long long>(r.publish_dropped), static_cast<long long>(r.publisher->failed),
                 r.publisher->imu_pose_latency.mean_ms, r.publisher->imu_pose_latency_p99_ms);
+  if (r.loop)
+    std::printf("loop        %s: %lld keyframes, %zu verified loops, %lld optimisations, %.1f ms per keyframe "
+                "(max %.1f)%s\n",
+                loop::loop_mode_name(r.loop->mode), static_cast<long long>(r.loop->keyframes), r.loop->loops.size(),
+                static_cast<long long>(r.loop->optimizations), r.loop->keyframe_ms_mean, r.loop->keyframe_ms_max,
+                r.loop->keyframes_dropped ? fmt::format(", {} keyframes dropped", r.loop->keyframes_dropped).c_str() : "");
   if (outputs.ate().evaluated)
-    std::printf("ATE         %.4f m (SE3), %.4f m (Sim3) over %zu poses\n", outputs.ate().se3_m, outputs.ate().sim3_m,
-                outputs.ate().matched);
+    std::printf("ATE         %.4f m (SE3), %.4f m (Sim3) over %zu poses (odometry)\n", outputs.ate().se3_m,
+                outputs.ate().sim3_m, outputs.ate().matched);
+  if (r.loop && outputs.trajectoryAte().evaluated)
+    std::printf("ATE         %.4f m (SE3), %.4f m (Sim3) after loop closure (trajectory.tum)\n",
+                outputs.trajectoryAte().se3_m, outputs.trajectoryAte().sim3_m);
   else if (!outputs.ate().error.empty())
     std::printf("ATE         not computed: %s\n", outputs.ate().error.c_str());
   std::printf("outputs     %s\n", out_dir.c_str());

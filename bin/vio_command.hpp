@@ -26,13 +26,20 @@ struct VioCommandOptions {
   bool gyro_prediction = false;
   std::string lcm_url;
   std::vector<std::string> channels;  ///< output channel overrides, key=NAME
+  std::string loop = "dynavins";      ///< off | all | switchable | dynavins
+  std::string vocabulary;             ///< empty: the default vocabulary (default_vocabulary_path())
 
-  /// Adds --config, --out, --ba, --mono, --gyro-prediction, --set, --imu-rate, --lcm-url, --channel.
+  /// Adds --config, --out, --ba, --mono, --gyro-prediction, --set, --imu-rate, --lcm-url, --channel,
+  /// --loop, --vocabulary.
   void add_options(CLI::App& cmd, const std::string& lcm_url_help);
   /// The run's options (config loaded, overrides applied, checked); CommandError (exit 2) naming the
   /// problem otherwise.
   pipeline::VioRunOptions load(double rate) const;
 };
+
+/// The shipped vocabulary: installed (<prefix>/share/dynavins/default_vocabulary.bin next to bin/) or
+/// in the source tree (data/vocabulary/default_vocabulary.bin).
+std::string default_vocabulary_path();
 
 /// What SIGINT means: for `run` the recording was not processed to its end (exit 130 after the outputs
 /// are written, marked interrupted); for `live` it is how a run ends.

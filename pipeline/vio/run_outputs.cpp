@@ -1,5 +1,7 @@
 #include "pipeline/vio/run_outputs.hpp"
 
+#include "pipeline/vio/loop_outputs.hpp"
+
 #include <algorithm>
 #include <cinttypes>
 #include <cmath>
@@ -22,6 +24,8 @@ const char* const kFeatures = "features.csv";
 const char* const kEvents = "estimator_events.csv";
 const char* const kGroundTruth = "groundtruth.tum";
 const char* const kSummary = "summary.json";
+const char* const kTrajectory = "trajectory.tum";
+const char* const kLoops = "loops.csv";
 const char* const kPartial = ".partial";
 
 // A JSON number; NaN / inf have no JSON form and become null.
@@ -96,7 +100,7 @@ RunOutputs::RunOutputs(const std::string& dir) : dir_(dir) {
   fs::create_directories(dir_, ec);
   if (ec || !fs::is_directory(dir_)) throw std::runtime_error(dir_ + ": cannot create the output directory: " + ec.message());
   // Results of an earlier run in the same place would look like this run's if it fails.
-  for (const char* name : {kOdometry, kFeatures, kEvents, kGroundTruth, kSummary}) {
+  for (const char* name : {kOdometry, kFeatures, kEvents, kGroundTruth, kSummary, kTrajectory, kLoops}) {
     fs::remove(path(name), ec);
     fs::remove(path(name) + kPartial, ec);
   }
@@ -157,11 +161,11 @@ void RunOutputs::write(const estimator::WindowEstimate& e) {
 
 void RunOutputs::complete(const VioRunResult& run, const RunDescription& what) {
   const bool has_gt = !run.ground_truth.empty();
+  eval::Trajectory truth;
   if (has_gt) {
     std::ofstream gt(path(kGroundTruth) + kPartial, std::ios::out | std::ios::trunc);
     check(gt, kGroundTruth);
     gt << "# t[s] x y z qx qy qz qw (ground truth of the source, body in world)\n";
-    eval::Trajectory truth;
     truth.source = path(kGroundTruth);
     for (const GroundTruthState& g : run.ground_truth) {
       gt << tumLine(g.t_ns, g.p_wb, g.q_wb);
@@ -180,7 +184,33 @@ void RunOutputs::complete(const VioRunResult& run, const RunDescription& what) {
     if (!*f) throw std::runtime_error(dir_ + ": writing the outputs failed");
     f->close();
   }
+  // trajectory.tum: after the final pose-graph optimisation (the odometry when loop closure is off).
+  const LoopRunSummary* loop = run.loop ? &*run.loop : nullptr;
+  const eval::Trajectory trajectory = correctedTrajectory(estimated_, loop);
+  {
+    std::ofstream t(path(kTrajectory) + kPartial, std::ios::out | std::ios::trunc);
+    t << "# t[s] x y z qx qy qz qw (every frame after the final pose-graph optimisation; the odometry without loops)\n";
+    for (const eval::StampedPose& p : trajectory.poses) t << tumLine(p.t_ns, p.p, p.q);
+    t.flush();
+    check(t, kTrajectory);
+    written_.push_back(kTrajectory);
+  }
+  std::string loop_json;
+  if (loop) {
+    const LoopTruthCounts counts = writeLoopsCsv(path(kLoops) + kPartial, *loop, truth);
+    written_.push_back(kLoops);
+    loop_json = loopJson(*loop, counts, has_gt);
+    if (has_gt && !trajectory.empty()) trajectory_ate_ = evaluateAte(truth, trajectory);
+  }
   summary_ = pipeline::summaryJson(run, what, totals_, ate_, totals_.tracking, has_gt);
+  if (loop) {  // the loop section goes in front of the pipeline report, the last key
+    const std::string tail = "  \"pipeline\": ";
+    std::string section = "  \"loop\": " + loop_json + ",\n";
+    if (trajectory_ate_.evaluated)
+      section += "  \"trajectory_ate_se3_m\": " + num(trajectory_ate_.se3_m) + ",\n  \"trajectory_ate_sim3_m\": " +
+                 num(trajectory_ate_.sim3_m) + ",\n";
+    summary_.insert(summary_.rfind(tail), section);
+  }
   {
     std::ofstream s(path(kSummary) + kPartial, std::ios::out | std::ios::trunc);
     s << summary_ << '\n';

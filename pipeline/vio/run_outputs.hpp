@@ -65,8 +65,9 @@ class RunOutputs {
 
   const std::string& dir() const { return dir_; }
   const EstimateTotals& totals() const { return totals_; }
-  /// Filled by complete().
+  /// Filled by complete(): the odometry's ATE, and trajectory.tum's (with loop closure on).
   const AteResult& ate() const { return ate_; }
+  const AteResult& trajectoryAte() const { return trajectory_ate_; }
   /// Filled by complete(): the summary.json text.
   const std::string& summaryJson() const { return summary_; }
 
@@ -78,7 +79,7 @@ class RunOutputs {
   std::ofstream odometry_, features_, events_;
   EstimateTotals totals_;
   eval::Trajectory estimated_;  // the odometry, kept for the ATE
-  AteResult ate_;
+  AteResult ate_, trajectory_ate_;
   std::string summary_;
   std::vector<std::string> written_;  // final names of the files to rename
 };

@@ -146,7 +146,23 @@ VioRunResult runVio(io::SensorSource& source, const VioRunOptions& opt, const Vi
     from_imu->close();
     if (imu_pub) imu_pub->close();
   });
-  p.add_stage("estimator", st.estimator, est_in, into(estimates), [&] { estimates.close(); });
+  // The loop closer: keyframes leave the estimator's thread through their own queue (lossless at rate 0;
+  // in real time a full queue drops the keyframe and counts it rather than stall the estimator).
+  SpscQueue<Keyframe>* keyframes = nullptr;
+  if (sinks.keyframe) st.estimator.on_keyframe = [&](Keyframe&& kf) { sinks.keyframe(kf); };
+  if (st.loop) {
+    keyframes = &p.add_queue<Keyframe>("keyframes", opt.keyframe_queue, Backpressure::Block);
+    st.estimator.on_keyframe = [&](Keyframe&& kf) {
+      if (sinks.keyframe) sinks.keyframe(kf);
+      if (paced ? keyframes->try_push(std::move(kf)) : keyframes->push(std::move(kf))) return;
+      if (!p.stop_flag().aborted()) ++st.loop->dropped;
+    };
+  }
+  p.add_stage("estimator", st.estimator, est_in, into(estimates), [&] {
+    estimates.close();
+    if (keyframes) keyframes->close();
+  });
+  if (st.loop) p.add_stage("loop", *st.loop, *keyframes, NoOutput{}, {});
   p.add_stage("writer", st.writer, estimates, NoOutput{}, [&] {
     if (writer_pub) writer_pub->close();
   });
@@ -181,6 +197,14 @@ VioRunResult runVioSequential(io::SensorSource& source, const VioRunOptions& opt
     }
     stage = "replay";
   };
+  if (sinks.keyframe) st.estimator.on_keyframe = [&](Keyframe&& kf) { sinks.keyframe(kf); };
+  if (st.loop)
+    st.estimator.on_keyframe = [&](Keyframe&& kf) {
+      if (sinks.keyframe) sinks.keyframe(kf);
+      stage = "loop";
+      st.loop->process(std::move(kf));
+      stage = "estimator";
+    };
   StopFlag stop;
   bool interrupted = false;
   ReplayRouting route;
@@ -215,6 +239,10 @@ VioRunResult runVioSequential(io::SensorSource& source, const VioRunOptions& opt
     route.finish();
     stage = "estimator";
     st.estimator.finish();
+    if (st.loop) {
+      stage = "loop";
+      st.loop->finish();
+    }
   } catch (const std::exception& e) {
     result.report.ok = false;
     result.report.failed_thread = stage;

@@ -33,6 +33,8 @@
 #include "io/sensor_source.hpp"
 #include "messages/tracked_frame.hpp"
 #include "pipeline/lcm_publisher.hpp"
+#include "pipeline/vio/loop_stage.hpp"
+#include "stages/loop/graph/loop_mode.hpp"
 #include "pipeline/pipeline.hpp"
 #include "pipeline/replay.hpp"
 #include "pipeline/stop_flag.hpp"
@@ -67,6 +69,12 @@ struct VioRunOptions {
   std::string lcm_url;
   PublisherChannels channels;
   std::size_t publish_queue = 4096;  ///< items waiting for the publisher; a full queue drops (counted)
+  /// Loop closure (paper IV) on the keyframes the estimator lets go: Off runs no loop stage (the
+  /// trajectory is the odometry). `vocabulary` is the vocabulary tree file the place recognition uses.
+  loop::LoopMode loop_mode = loop::LoopMode::Off;
+  std::string vocabulary;
+  /// Keyframes waiting for the loop closer; rate 0 blocks (lossless), real time drops (counted).
+  std::size_t keyframe_queue = 64;
 };
 
 /// Where the results go. Threaded: `estimate` is called on the writer thread, `tracked` on the tracker
@@ -76,6 +84,9 @@ struct VioSinks {
   std::function<void(const estimator::WindowEstimate&)> estimate;
   /// Every tracked frame, right after the tracker (e.g. to score tracks against simulator truth).
   std::function<void(const TrackedFrame&)> tracked;
+  /// Every keyframe the estimator lets go (the loop closer's input; also the window's last keyframes at
+  /// the end), on the estimator's thread, before the loop closer gets it.
+  std::function<void(const Keyframe&)> keyframe;
 };
 
 /// Everything a run measured; the stage counters are read after all threads have ended.
@@ -107,6 +118,7 @@ struct VioRunResult {
   std::vector<GroundTruthState> ground_truth;  ///< the source's ground truth, in time order
   std::optional<PublisherStats> publisher;     ///< what was published (with lcm_url)
   int64_t publish_dropped = 0;                 ///< items the full publish queue dropped
+  std::optional<LoopRunSummary> loop;          ///< what the loop closer did (loop_mode != Off)
   bool interrupted() const { return report.interrupted || replay.stopped; }
 };
 

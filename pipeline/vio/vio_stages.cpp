@@ -65,6 +65,9 @@ std::vector<estimator::WindowEstimate> EstimatorStage::process(estimator::Estima
   for (FrameWithImu& f : ready) {
     out.push_back(estimator.process(f.frame, f.imu ? &*f.imu : nullptr));
     out.back().received_ns = f.frame.received_ns;
+    for (Keyframe& kf : out.back().finished_keyframes)
+      if (on_keyframe) on_keyframe(std::move(kf));
+    out.back().finished_keyframes.clear();  // the images go no further than the loop closer
     const estimator::WindowEstimate& e = out.back();
     if (e.status == estimator::EstimatorStatus::Tracking) {
       ++tracking;
@@ -76,6 +79,13 @@ std::vector<estimator::WindowEstimate> EstimatorStage::process(estimator::Estima
     if (!e.event.empty()) spdlog::info("estimator: t = {} ns: {}", e.t_ns, e.event);
   }
   return out;
+}
+
+void EstimatorStage::finish() {
+  pairer.finish();
+  std::vector<Keyframe> rest = estimator.flushKeyframes();
+  if (on_keyframe)
+    for (Keyframe& kf : rest) on_keyframe(std::move(kf));
 }
 
 void WriterStage::process(estimator::WindowEstimate e) {
@@ -129,7 +139,10 @@ VioStages::VioStages(const VioRunOptions& o, std::function<void(const TrackedFra
       imu{ImuStage(ImuStageOptions::from(o.estimator, o.imu_rate_hz, o.imu_noise)), latest, {},
           ImuPropagator(ImuPropagatorOptions{o.estimator.g_norm})},
       estimator{FrameImuPairer{}, estimator::SlidingWindowEstimator(estimatorOptions(o), o.mode), latest, gyro_bias},
-      writer{std::move(on_estimate), {}, 0, 0} {}
+      writer{std::move(on_estimate), {}, 0, 0} {
+  if (o.loop_mode != loop::LoopMode::Off)
+    loop = std::make_unique<LoopStage>(o.loop_mode, o.vocabulary, o.estimator.cameras.at(0));
+}
 
 void VioStages::collect(VioRunResult& r) const {
   r.gyro_prediction = predict;
@@ -146,6 +159,7 @@ void VioStages::collect(VioRunResult& r) const {
   r.imu = imu.stage.stats();
   r.imu_builder = imu.stage.builderStats();
   r.pairer = estimator.pairer.stats();
+  if (loop) r.loop = loop->summary();
 }
 
 }  // namespace dynavins::pipeline

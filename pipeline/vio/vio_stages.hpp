@@ -14,6 +14,7 @@
 #include <climits>
 #include <cstdint>
 #include <functional>
+#include <memory>
 #include <optional>
 #include <vector>
 
@@ -22,6 +23,7 @@
 #include "messages/tracked_frame.hpp"
 #include "pipeline/latest_value.hpp"
 #include "pipeline/publish_item.hpp"
+#include "pipeline/vio/loop_stage.hpp"
 #include "pipeline/vio/frame_imu_attacher.hpp"
 #include "messages/estimator_input.hpp"
 #include "stages/estimator/sliding_window_estimator.hpp"
@@ -78,15 +80,18 @@ struct ImuFeedbackStage {
 };
 
 /// Estimator: pairs frames with their IMU intervals, runs the window BA, publishes the newest state.
+/// The keyframes that leave the window (and, at the end, those still in it) go to `on_keyframe` (the
+/// loop closer), never downstream with the estimates.
 struct EstimatorStage {
   std::vector<estimator::WindowEstimate> process(estimator::EstimatorInput in);
-  void finish() { pairer.finish(); }
+  void finish();
 
   FrameImuPairer pairer;
   estimator::SlidingWindowEstimator estimator;
   LatestValue<NavState>& latest;
   LatestValue<Eigen::Vector3d>& gyro_bias;  ///< the same state's gyro bias, for the tracker
   int64_t tracking = 0, resets = 0;
+  std::function<void(Keyframe&&)> on_keyframe = {};  ///< may be empty (no loop closure): keyframes are dropped
 };
 
 /// Writer: hands each estimate to the run's sink and, with `publish`, its status, window pose and weighted
@@ -118,6 +123,7 @@ struct VioStages {
   ImuFeedbackStage imu;
   EstimatorStage estimator;
   WriterStage writer;
+  std::unique_ptr<LoopStage> loop;  ///< null when loop closure is off
 };
 
 }  // namespace dynavins::pipeline

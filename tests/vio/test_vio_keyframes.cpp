@@ -37,12 +37,12 @@ TEST_CASE("finished keyframes of a moving scene: once each, in order, kept frame
   pipeline::VioSinks sinks;
   sinks.estimate = [&](const estimator::WindowEstimate& e) {
     recorder.record(e);
-    for (const Keyframe& kf : e.finished_keyframes) keyframes.push_back(kf);
     estimator::WindowEstimate light = e;
     light.features.features.clear();
     light.finished_keyframes.clear();
     estimates.push_back(std::move(light));
   };
+  sinks.keyframe = [&](const Keyframe& kf) { keyframes.push_back(kf); };
   const pipeline::VioRunResult r = pipeline::runVioSequential(src, opt, sinks);
   REQUIRE(r.report.ok);
   REQUIRE(r.resets == 0);

@@ -1,0 +1,91 @@
+#include "pipeline/vio/loop_stage.hpp"
+
+#include <algorithm>
+#include <chrono>
+#include <stdexcept>
+#include <utility>
+
+#include <spdlog/spdlog.h>
+
+#include "stages/common/camera_model.hpp"
+#include "stages/loop/loop_closer.hpp"
+#include "stages/loop/place/vocabulary_tree.hpp"
+
+namespace dynavins::pipeline {
+
+LoopStage::LoopStage(loop::LoopMode mode, const std::string& vocabulary_path, std::shared_ptr<const CameraModel> camera)
+    : mode_(mode), vocabulary_path_(vocabulary_path) {
+  std::shared_ptr<const loop::VocabularyTree> vocabulary;
+  try {
+    vocabulary = std::make_shared<const loop::VocabularyTree>(loop::VocabularyTree::load(vocabulary_path));
+  } catch (const std::exception& e) {
+    throw std::runtime_error(std::string("loop closure vocabulary: ") + e.what());
+  }
+  loop::LoopCloserOptions o;
+  o.mode = mode;
+  loop::Undistort undistort;
+  if (camera)
+    undistort = [camera](const Eigen::Vector2d& px) -> Eigen::Vector2d {
+      const Eigen::Vector3d b = camera->lift(px);
+      return b.head<2>() / b.z();
+    };
+  closer_ = std::make_unique<loop::LoopCloser>(std::move(vocabulary), o, std::move(undistort));
+}
+
+LoopStage::~LoopStage() = default;
+
+void LoopStage::account(const loop::LoopCloserOutput& out, double ms) {
+  ms_sum_ += ms;
+  ms_max_ = std::max(ms_max_, ms);
+  if (out.optimized) {
+    opt_ms_max_ = std::max(opt_ms_max_, out.timing.optimization_ms);
+    spdlog::debug("loop: optimised at t = {} ns ({:.1f} ms)", out.t_ns, out.timing.optimization_ms);
+  }
+  if (on_output) on_output(out);
+}
+
+void LoopStage::process(Keyframe keyframe) {
+  const auto t0 = std::chrono::steady_clock::now();
+  const loop::LoopCloserOutput out = closer_->add_keyframe(keyframe);
+  ++keyframes_;
+  account(out, std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count());
+}
+
+void LoopStage::finish() {
+  const auto t0 = std::chrono::steady_clock::now();
+  const loop::LoopCloserOutput out = closer_->finish();
+  account(out, std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count());
+  spdlog::info("loop: {} keyframes, {} verified loops, {} groups, {} optimisations ({})", keyframes_,
+               closer_->loops().size(), closer_->groups().size(), closer_->num_optimizations(),
+               loop::loop_mode_name(mode_));
+}
+
+LoopRunSummary LoopStage::summary() const {
+  LoopRunSummary s;
+  s.mode = mode_;
+  s.vocabulary = vocabulary_path_;
+  s.keyframes = keyframes_;
+  s.keyframes_dropped = dropped;
+  s.groups = static_cast<int64_t>(closer_->groups().size());
+  s.optimizations = closer_->num_optimizations();
+  s.keyframe_ms_mean = keyframes_ > 0 ? ms_sum_ / static_cast<double>(keyframes_) : 0.0;
+  s.keyframe_ms_max = ms_max_;
+  s.optimization_ms_max = opt_ms_max_;
+  s.memory_bytes = closer_->memory_bytes();
+  s.corrections = closer_->keyframe_corrections();
+  s.loops = closer_->loops();
+  if (closer_->num_optimizations() > 0) s.rows = loop::loop_report(closer_->optimizer(), closer_->last_result());
+  if (s.rows.size() != s.loops.size()) {  // never optimised (or off): the loops without weights
+    s.rows.clear();
+    for (const VerifiedLoop& l : s.loops) {
+      loop::LoopReportRow r;
+      r.query_t_ns = l.query_t_ns;
+      r.match_t_ns = l.match_t_ns;
+      r.inliers = l.inliers;
+      s.rows.push_back(r);
+    }
+  }
+  return s;
+}
+
+}  // namespace dynavins::pipeline
