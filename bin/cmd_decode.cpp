@@ -16,6 +16,8 @@
 #include <CLI/CLI.hpp>
 #include <fmt/format.h>
 
+#include <dynavins_lcm/loop_hypotheses_t.hpp>
+#include <dynavins_lcm/path_t.hpp>
 #include <dynavins_lcm/pipeline_stats_t.hpp>
 #include <dynavins_lcm/pose_t.hpp>
 #include <dynavins_lcm/status_t.hpp>
@@ -85,9 +87,10 @@ void runDecode(const DecodeOptions& o) {
   }
 
   std::map<std::string, ChannelCount> counts;
-  eval::Trajectory window, imu_rate;
+  eval::Trajectory window, imu_rate, corrected;
   window.source = o.log + ":" + ch.pose;
   imu_rate.source = o.log + ":" + ch.pose_imu;
+  corrected.source = o.log + ":" + ch.pose_corrected;
   std::vector<std::string> status_rows;
   int64_t features = 0, rejected = 0, other_events = 0;
   float w_min = 1.f, w_max = 0.f;
@@ -96,11 +99,22 @@ void runDecode(const DecodeOptions& o) {
   try {
     while (reader->next(r)) {
       try {
-        if (r.channel == ch.pose || r.channel == ch.pose_imu) {
+        if (r.channel == ch.pose || r.channel == ch.pose_imu || r.channel == ch.pose_corrected) {
           const auto m = reader->decode<dynavins_lcm::pose_t>(r);
           counts[r.channel].add(m.utime);
           if (!finitePose(m)) f.fail(reader->where(r) + ": pose is not finite or its quaternion is not unit");
-          (r.channel == ch.pose ? window : imu_rate).poses.push_back(stamped(m));
+          (r.channel == ch.pose ? window : r.channel == ch.pose_imu ? imu_rate : corrected).poses.push_back(stamped(m));
+        } else if (r.channel == ch.path) {
+          const auto m = reader->decode<dynavins_lcm::path_t>(r);
+          counts[r.channel].add(m.utime);
+          for (const auto& p : m.poses)
+            if (!finitePose(p)) f.fail(reader->where(r) + ": a path pose is not finite");
+        } else if (r.channel == ch.loops) {
+          const auto m = reader->decode<dynavins_lcm::loop_hypotheses_t>(r);
+          counts[r.channel].add(m.utime);
+          for (const auto& h : m.hypotheses)
+            if (!(h.weight >= 0.f && h.weight <= 1.f))
+              f.fail(fmt::format("{}: hypothesis weight {} outside [0, 1]", reader->where(r), h.weight));
         } else if (r.channel == ch.features) {
           const auto m = reader->decode<dynavins_lcm::weighted_feature_set_t>(r);
           counts[r.channel].add(m.utime);
@@ -147,6 +161,7 @@ void runDecode(const DecodeOptions& o) {
     std::filesystem::create_directories(o.out);
     eval::write_tum(o.out + "/pose.tum", window);
     eval::write_tum(o.out + "/pose_imu.tum", imu_rate);
+    if (!corrected.empty()) eval::write_tum(o.out + "/pose_corrected.tum", corrected);
     std::ofstream s(o.out + "/status.csv");
     s << "utime,status,frames,resets,reason\n";
     for (const auto& row : status_rows) s << row << "\n";

@@ -37,7 +37,8 @@ void VioCommandOptions::add_options(CLI::App& cmd, const std::string& lcm_url_he
       ->capture_default_str();
   cmd.add_option("--vocabulary", vocabulary, "Vocabulary tree for place recognition (default: the shipped one)");
   cmd.add_option("--channel", channels,
-                 "Rename an output channel: --channel key=NAME (keys: pose_imu, pose, features, status, stats)");
+                 "Rename an output channel: --channel key=NAME (keys: pose_imu, pose, pose_corrected, features, status, stats, "
+                 "loops, path)");
 }
 
 pipeline::VioRunOptions VioCommandOptions::load(double rate) const {

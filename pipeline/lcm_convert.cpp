@@ -192,6 +192,35 @@ WeightedFeatureSet from_lcm(const dynavins_lcm::weighted_feature_set_t& msg) {
   return set;
 }
 
+dynavins_lcm::path_t to_lcm(const PathUpdate& path) {
+  dynavins_lcm::path_t msg;
+  msg.utime = ns_to_utime(path.t_ns);
+  for (const PoseEstimate& p : path.poses) msg.poses.push_back(to_lcm(p));
+  msg.num_poses = static_cast<int32_t>(msg.poses.size());
+  return msg;
+}
+
+dynavins_lcm::loop_hypotheses_t to_lcm(const HypothesesUpdate& u) {
+  dynavins_lcm::loop_hypotheses_t msg;
+  msg.utime = ns_to_utime(u.t_ns);
+  msg.group_first_utime = ns_to_utime(u.group_first_t_ns);
+  msg.group_size = u.group_size;
+  for (const HypothesesUpdate::Hypothesis& h : u.hypotheses) {
+    dynavins_lcm::loop_hypothesis_t m;
+    m.weight = h.weight;
+    put3(m.position, h.first_keyframe.p_wb);
+    put_quat(m.orientation, h.first_keyframe.q_wb);
+    for (const auto& [query, match] : h.loops) {
+      m.query_utime.push_back(ns_to_utime(query));
+      m.match_utime.push_back(ns_to_utime(match));
+    }
+    m.num_loops = static_cast<int32_t>(m.query_utime.size());
+    msg.hypotheses.push_back(m);
+  }
+  msg.num_hypotheses = static_cast<int32_t>(msg.hypotheses.size());
+  return msg;
+}
+
 dynavins_lcm::pipeline_stats_t to_lcm(const RunReport& report, int64_t wall_utime, double sensor_s) {
   dynavins_lcm::pipeline_stats_t msg;
   msg.utime = wall_utime;

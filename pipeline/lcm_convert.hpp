@@ -8,6 +8,8 @@
 #include <dynavins_lcm/ground_truth_t.hpp>
 #include <dynavins_lcm/image_t.hpp>
 #include <dynavins_lcm/imu_t.hpp>
+#include <dynavins_lcm/loop_hypotheses_t.hpp>
+#include <dynavins_lcm/path_t.hpp>
 #include <dynavins_lcm/pipeline_stats_t.hpp>
 #include <dynavins_lcm/pose_t.hpp>
 #include <dynavins_lcm/stereo_image_t.hpp>
@@ -15,6 +17,7 @@
 
 #include "messages/estimate_messages.hpp"
 #include "messages/sensor_messages.hpp"
+#include "pipeline/publish_item.hpp"
 
 namespace dynavins::pipeline {
 
@@ -44,6 +47,9 @@ PoseEstimate from_lcm(const dynavins_lcm::pose_t& msg);
 
 dynavins_lcm::weighted_feature_set_t to_lcm(const WeightedFeatureSet& set);
 WeightedFeatureSet from_lcm(const dynavins_lcm::weighted_feature_set_t& msg);
+
+dynavins_lcm::path_t to_lcm(const PathUpdate& path);
+dynavins_lcm::loop_hypotheses_t to_lcm(const HypothesesUpdate& update);
 
 /// The pipeline's counters as a stats message; `sensor_s` is how much sensor time was processed.
 dynavins_lcm::pipeline_stats_t to_lcm(const RunReport& report, int64_t wall_utime, double sensor_s);

@@ -37,12 +37,16 @@ dynavins_lcm::status_t toLcm(const StatusUpdate& s) {
 PublisherChannels::PublisherChannels()
     : pose_imu(channels::kPoseImuRate),
       pose(channels::kPose),
+      pose_corrected(channels::kPoseCorrected),
       features(channels::kFeatures),
       status(channels::kStatus),
-      stats(channels::kStats) {}
+      stats(channels::kStats),
+      loops(channels::kLoops),
+      path(channels::kPath) {}
 
 std::vector<std::pair<std::string, std::string>> PublisherChannels::list() const {
-  return {{"pose_imu", pose_imu}, {"pose", pose}, {"features", features}, {"status", status}, {"stats", stats}};
+  return {{"pose_imu", pose_imu}, {"pose", pose},     {"pose_corrected", pose_corrected}, {"features", features},
+          {"status", status},     {"stats", stats},   {"loops", loops},                   {"path", path}};
 }
 
 void PublisherChannels::set(const std::string& assignment) {
@@ -53,12 +57,11 @@ void PublisherChannels::set(const std::string& assignment) {
   for (const auto& [k, v] : list()) keys += (keys.empty() ? "" : ", ") + k;
   if (eq == std::string::npos || name.empty())
     throw std::invalid_argument("channel override '" + assignment + "': expected key=NAME (keys: " + keys + ")");
-  std::string* target = key == "pose_imu" ? &pose_imu
-                        : key == "pose"   ? &pose
-                        : key == "features" ? &features
-                        : key == "status" ? &status
-                        : key == "stats"  ? &stats
-                                          : nullptr;
+  std::string* target = nullptr;
+  for (auto [k, field] : {std::pair{"pose_imu", &pose_imu}, {"pose", &pose}, {"pose_corrected", &pose_corrected},
+                          {"features", &features}, {"status", &status}, {"stats", &stats}, {"loops", &loops},
+                          {"path", &path}})
+    if (key == k) target = field;
   if (!target) throw std::invalid_argument("unknown output channel key '" + key + "' (keys: " + keys + ")");
   *target = name;
 }
@@ -93,12 +96,20 @@ void LcmPublisher::process(PublishItem item) {
         using T = std::decay_t<decltype(x)>;
         if constexpr (std::is_same_v<T, PoseEstimate>) {
           const bool imu = x.source == PoseSource::ImuRate;
+          if (x.source == PoseSource::LoopCorrected) {
+            send(channels_.pose_corrected, to_lcm(x), stats_.corrected_poses);
+            return;
+          }
           send(imu ? channels_.pose_imu : channels_.pose, to_lcm(x), imu ? stats_.imu_poses : stats_.window_poses);
           if (item.origin_ns > 0) (imu ? imu_latency_ : window_latency_).record(steady_now_ns() - item.origin_ns);
           if (!first_t_ns_) first_t_ns_ = x.state.t_ns;
           last_t_ns_ = x.state.t_ns;
         } else if constexpr (std::is_same_v<T, WeightedFeatureSet>) {
           send(channels_.features, to_lcm(x), stats_.feature_sets);
+        } else if constexpr (std::is_same_v<T, PathUpdate>) {
+          send(channels_.path, to_lcm(x), stats_.paths);
+        } else if constexpr (std::is_same_v<T, HypothesesUpdate>) {
+          send(channels_.loops, to_lcm(x), stats_.hypotheses);
         } else {
           // A change (new status or an event) goes out at once; otherwise the status is only
           // refreshed, and publishPeriodic() sends it with the reason of the change that led to it.

@@ -28,9 +28,9 @@ namespace dynavins::pipeline {
 
 /// Output channel names; the defaults are pipeline/lcm_channels.hpp's.
 struct PublisherChannels {
-  std::string pose_imu, pose, features, status, stats;
+  std::string pose_imu, pose, pose_corrected, features, status, stats, loops, path;
   PublisherChannels();
-  /// Sets one name from "key=NAME" (key: pose_imu, pose, features, status, stats). Throws
+  /// Sets one name from "key=NAME" (a key of list()). Throws
   /// std::invalid_argument naming the key and listing the valid ones.
   void set(const std::string& assignment);
   /// (key, channel) for every output, in a fixed order (logs, README).
@@ -40,7 +40,8 @@ struct PublisherChannels {
 /// What the publisher sent, for the run summary.
 struct PublisherStats {
   std::string url;
-  int64_t imu_poses = 0, window_poses = 0, feature_sets = 0, status = 0, stats = 0;
+  int64_t imu_poses = 0, window_poses = 0, corrected_poses = 0, feature_sets = 0, status = 0, stats = 0;
+  int64_t paths = 0, hypotheses = 0;
   int64_t failed = 0;  ///< lcm publish calls that returned an error
   /// Input arrival -> published, per pose kind (steady clock; the queue wait before the first stage is
   /// in that stage's wait statistics).

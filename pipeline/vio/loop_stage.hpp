@@ -55,6 +55,8 @@ class LoopStage {
   void finish();
   /// After the last input.
   LoopRunSummary summary() const;
+  /// The loop closer itself (its loops and groups), for on_output on the loop stage's thread.
+  const loop::LoopCloser& closer() const { return *closer_; }
 
   /// Each output of the loop closer (publisher: path, hypotheses, drift); may be empty.
   std::function<void(const loop::LoopCloserOutput&)> on_output;

@@ -12,6 +12,8 @@
 #include "pipeline/emit.hpp"
 #include "pipeline/interrupt.hpp"
 #include "pipeline/vio/frame_imu_attacher.hpp"
+#include "pipeline/latest_value.hpp"
+#include "stages/loop/loop_closer.hpp"
 #include "pipeline/vio/vio_stages.hpp"
 
 namespace dynavins::pipeline {
@@ -57,6 +59,45 @@ struct ReplayRouting {
   /// End of the replay: the frame still waiting for its IMU goes on without it.
   void finish() { pushAttached(attacher.finish()); }
 };
+
+/// The loop closer's output for the publisher: after an optimisation the keyframe path and each group's
+/// hypotheses; always the newest drift, for the loop-corrected window pose.
+void publishLoopOutput(const loop::LoopCloserOutput& out, const loop::LoopCloser& closer,
+                       FanInQueue<PublishItem>::Producer& pub, LatestValue<loop::RigidPose>& drift) {
+  drift.write(out.drift);
+  if (!out.optimized) return;
+  PathUpdate path;
+  path.t_ns = out.t_ns;
+  for (std::size_t i = 0; i < out.corrected.size() && i < out.keyframe_t_ns.size(); ++i) {
+    PoseEstimate p;
+    p.source = PoseSource::LoopCorrected;
+    p.state.t_ns = out.keyframe_t_ns[i];
+    p.state.p_wb = out.corrected[i].p;
+    p.state.q_wb = out.corrected[i].q;
+    path.poses.push_back(p);
+  }
+  for (const loop::HypothesisReport& h : out.hypotheses) {
+    HypothesesUpdate u;
+    u.t_ns = out.t_ns;
+    u.group_first_t_ns = h.group_first_t_ns;
+    if (h.group >= 0 && static_cast<std::size_t>(h.group) < closer.groups().size())
+      u.group_size = static_cast<int32_t>(closer.groups()[static_cast<std::size_t>(h.group)].t_ns.size());
+    NavState first;
+    for (const PoseEstimate& p : path.poses)
+      if (p.state.t_ns == h.group_first_t_ns) first = p.state;
+    for (const auto& [indices, w] : {std::pair{&h.h0, h.w0}, {&h.h1, h.w1}}) {
+      if (indices->empty()) continue;
+      HypothesesUpdate::Hypothesis hyp;
+      hyp.weight = static_cast<float>(w);
+      hyp.first_keyframe = first;
+      for (std::size_t i : *indices)
+        if (i < closer.loops().size()) hyp.loops.emplace_back(closer.loops()[i].query_t_ns, closer.loops()[i].match_t_ns);
+      u.hypotheses.push_back(std::move(hyp));
+    }
+    pub.push(PublishItem{0, std::move(u)});
+  }
+  pub.push(PublishItem{0, std::move(path)});
+}
 
 void countFrames(VioRunResult& result) {
   for (const auto& q : result.report.queues)
@@ -146,6 +187,23 @@ VioRunResult runVio(io::SensorSource& source, const VioRunOptions& opt, const Vi
     from_imu->close();
     if (imu_pub) imu_pub->close();
   });
+  // Loop outputs for the publisher: the path and hypotheses of each optimisation from the loop thread,
+  // the drift through a snapshot that the writer applies to each window pose.
+  LatestValue<loop::RigidPose> drift;
+  std::unique_ptr<FanInQueue<PublishItem>::Producer> loop_pub;
+  if (publisher && st.loop) {
+    loop_pub = publish_q->make_producer();
+    st.loop->on_output = [&](const loop::LoopCloserOutput& out) { publishLoopOutput(out, st.loop->closer(), *loop_pub, drift); };
+    st.writer.correct = [&drift](const NavState& s) -> std::optional<NavState> {
+      const auto d = drift.read();
+      if (!d) return std::nullopt;
+      NavState c = s;
+      c.p_wb = d->p + d->q * s.p_wb;
+      c.q_wb = (d->q * s.q_wb).normalized();
+      c.v_wb = d->q * s.v_wb;
+      return c;
+    };
+  }
   // The loop closer: keyframes leave the estimator's thread through their own queue (lossless at rate 0;
   // in real time a full queue drops the keyframe and counts it rather than stall the estimator).
   SpscQueue<Keyframe>* keyframes = nullptr;
@@ -162,7 +220,9 @@ VioRunResult runVio(io::SensorSource& source, const VioRunOptions& opt, const Vi
     estimates.close();
     if (keyframes) keyframes->close();
   });
-  if (st.loop) p.add_stage("loop", *st.loop, *keyframes, NoOutput{}, {});
+  if (st.loop) p.add_stage("loop", *st.loop, *keyframes, NoOutput{}, [&] {
+    if (loop_pub) loop_pub->close();
+  });
   p.add_stage("writer", st.writer, estimates, NoOutput{}, [&] {
     if (writer_pub) writer_pub->close();
   });

@@ -97,6 +97,8 @@ void WriterStage::process(estimator::WindowEstimate e) {
   publish(PublishItem{0, StatusUpdate{e.t_ns, e.status, e.event, frames, resets}});
   if (e.status != estimator::EstimatorStatus::Tracking) return;
   publish(PublishItem{e.received_ns, PoseEstimate{PoseSource::Window, e.state}});
+  if (correct)
+    if (const auto c = correct(e.state)) publish(PublishItem{0, PoseEstimate{PoseSource::LoopCorrected, *c}});
   publish(PublishItem{0, std::move(e.features)});
 }
 
@@ -139,7 +141,7 @@ VioStages::VioStages(const VioRunOptions& o, std::function<void(const TrackedFra
       imu{ImuStage(ImuStageOptions::from(o.estimator, o.imu_rate_hz, o.imu_noise)), latest, {},
           ImuPropagator(ImuPropagatorOptions{o.estimator.g_norm})},
       estimator{FrameImuPairer{}, estimator::SlidingWindowEstimator(estimatorOptions(o), o.mode), latest, gyro_bias},
-      writer{std::move(on_estimate), {}, 0, 0} {
+      writer{std::move(on_estimate), {}, {}, 0, 0} {
   if (o.loop_mode != loop::LoopMode::Off)
     loop = std::make_unique<LoopStage>(o.loop_mode, o.vocabulary, o.estimator.cameras.at(0));
 }

@@ -101,6 +101,9 @@ struct WriterStage {
 
   std::function<void(const estimator::WindowEstimate&)> sink;
   std::function<void(PublishItem)> publish;  ///< may be empty
+  /// With loop closure: the window state corrected by the loop closer's newest drift (nothing before the
+  /// first optimisation); published as the loop-corrected pose. May be empty.
+  std::function<std::optional<NavState>(const NavState&)> correct;
   int64_t frames = 0, resets = 0;
 };
 
