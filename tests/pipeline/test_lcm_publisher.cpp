@@ -4,6 +4,8 @@
 #include <catch2/catch.hpp>
 #include <lcm/lcm-cpp.hpp>
 
+#include <dynavins_lcm/loop_hypotheses_t.hpp>
+#include <dynavins_lcm/path_t.hpp>
 #include <dynavins_lcm/pipeline_stats_t.hpp>
 #include <dynavins_lcm/pose_t.hpp>
 #include <dynavins_lcm/status_t.hpp>
@@ -28,6 +30,8 @@ struct Recorder {
   std::vector<dynavins_lcm::pose_t> poses;
   std::vector<dynavins_lcm::status_t> status;
   std::vector<dynavins_lcm::weighted_feature_set_t> features;
+  dynavins_lcm::path_t path;
+  dynavins_lcm::loop_hypotheses_t hypotheses;
   void on(const lcm::ReceiveBuffer* rb, const std::string& ch) {
     ++count[ch];
     if (ch == "P" || ch == "P_IMU") {
@@ -38,6 +42,10 @@ struct Recorder {
       dynavins_lcm::status_t m;
       REQUIRE(m.decode(rb->data, 0, static_cast<int>(rb->data_size)) > 0);
       status.push_back(m);
+    } else if (ch == "PATH") {
+      REQUIRE(path.decode(rb->data, 0, static_cast<int>(rb->data_size)) > 0);
+    } else if (ch == "LOOPS") {
+      REQUIRE(hypotheses.decode(rb->data, 0, static_cast<int>(rb->data_size)) > 0);
     } else if (ch == "F") {
       dynavins_lcm::weighted_feature_set_t m;
       REQUIRE(m.decode(rb->data, 0, static_cast<int>(rb->data_size)) > 0);
@@ -131,7 +139,7 @@ TEST_CASE("LcmPublisher: a status change goes out at once, a repeat does not", "
   CHECK(rx.count["ST"] == 1);
 }
 
-TEST_CASE("PublisherChannels: key=NAME overrides; bad keys are named", "[lcm_publisher]") {
+TEST_CASE("PublisherChannels: key=NAME overrides, bad keys are named", "[lcm_publisher]") {
   PublisherChannels c;
   CHECK(c.pose == "DYNAVINS_POSE");
   c.set("pose=ROBOT_POSE");
@@ -139,4 +147,49 @@ TEST_CASE("PublisherChannels: key=NAME overrides; bad keys are named", "[lcm_pub
   CHECK_THROWS_WITH(c.set("posture=X"), Catch::Contains("posture") && Catch::Contains("pose_imu"));
   CHECK_THROWS_WITH(c.set("pose="), Catch::Contains("key=NAME"));
   CHECK_THROWS_WITH(c.set("pose"), Catch::Contains("key=NAME"));
+}
+
+TEST_CASE("LcmPublisher: loop outputs (corrected pose, path, hypotheses) reach their channels", "[lcm_publisher]") {
+  lcm::LCM lcm("memq://");
+  Recorder rx;
+  lcm.subscribe(".*", &Recorder::on, &rx);
+  PublisherChannels c = testChannels();
+  c.set("pose_corrected=PC");
+  c.set("path=PATH");
+  c.set("loops=LOOPS");
+  LcmPublisher pub(lcm, c);
+  NavState s;
+  s.t_ns = 2'000'000'000;
+  pub.process(PublishItem{0, PoseEstimate{PoseSource::LoopCorrected, s}});
+  PathUpdate path;
+  path.t_ns = s.t_ns;
+  path.poses.assign(3, PoseEstimate{PoseSource::LoopCorrected, s});
+  pub.process(PublishItem{0, path});
+  HypothesesUpdate h;
+  h.t_ns = s.t_ns;
+  h.group_first_t_ns = 1'000'000'000;
+  h.group_size = 9;
+  h.hypotheses.resize(2);
+  h.hypotheses[0].weight = 0.97f;
+  h.hypotheses[0].loops = {{1'500'000'000, 100'000'000}, {1'550'000'000, 150'000'000}};
+  h.hypotheses[1].weight = 0.01f;
+  h.hypotheses[1].loops = {{1'600'000'000, 900'000'000}};
+  pub.process(PublishItem{0, h});
+
+  drain(lcm);
+  const dynavins_lcm::path_t& got_path = rx.path;
+  const dynavins_lcm::loop_hypotheses_t& got_h = rx.hypotheses;
+  CHECK(rx.count["PC"] == 1);
+  CHECK(got_path.num_poses == 3);
+  REQUIRE(got_h.num_hypotheses == 2);
+  CHECK(got_h.group_first_utime == 1'000'000);
+  CHECK(got_h.group_size == 9);
+  CHECK(got_h.hypotheses[0].weight == 0.97f);
+  CHECK(got_h.hypotheses[0].num_loops == 2);
+  CHECK(got_h.hypotheses[0].match_utime[1] == 150'000);
+  CHECK(got_h.hypotheses[1].num_loops == 1);
+  const PublisherStats st = pub.stats();
+  CHECK(st.corrected_poses == 1);
+  CHECK(st.paths == 1);
+  CHECK(st.hypotheses == 1);
 }
