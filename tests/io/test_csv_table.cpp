@@ -18,7 +18,7 @@ std::string write_file(const std::string& name, const std::string& text) {
 }
 }  // namespace
 
-TEST_CASE("read_csv: comments, blank lines and CRLF; rows keep their line numbers", "[csv]") {
+TEST_CASE("read_csv: comments, blank lines and CRLF, rows keep their line numbers", "[csv]") {
   const auto path = write_file("ok.csv", "#timestamp [ns],filename\r\n1,a.png\r\n\r\n2, b.png\r\n");
   const auto rows = read_csv(path, 2);
   REQUIRE(rows.size() == 2);
