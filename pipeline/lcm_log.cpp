@@ -84,7 +84,7 @@ bool LcmLogReader::next(LogRecord& out) {
     throw std::runtime_error(at + ": corrupt event header (channel length " + std::to_string(channel_len) +
                              ", data length " + std::to_string(data_len) + ")");
   if (size_ - pos_ - kHeaderBytes < static_cast<int64_t>(channel_len) + data_len)
-    throw std::runtime_error(at + ": truncated (event needs " + std::to_string(channel_len + data_len) +
+    throw std::runtime_error(at + ": truncated (event needs " + std::to_string(static_cast<int64_t>(channel_len) + data_len) +
                              " bytes, file has " + std::to_string(size_ - pos_ - kHeaderBytes) + ")");
   out.offset = pos_;
   out.eventnum = static_cast<int64_t>(read_be(h + 4, 8));

@@ -96,6 +96,28 @@ TEST_CASE("LCM log: a truncated log is an error naming the file, event and byte"
   CHECK(read == 21);
 }
 
+TEST_CASE("LCM log: an event claiming 0x7fffffff data bytes is reported with its true size", "[lcm][log]") {
+  const auto path = temp_log("huge_length.lcmlog");
+  write_sample_log(path);
+  {  // the first event's data length field (bytes 24..27 of its header) set to 0x7fffffff
+    std::fstream f(path, std::ios::in | std::ios::out | std::ios::binary);
+    f.seekp(24);
+    const char len[4] = {0x7f, static_cast<char>(0xff), static_cast<char>(0xff), static_cast<char>(0xff)};
+    f.write(len, 4);
+  }
+  LcmLogReader reader(path.string());
+  LogRecord r;
+  try {
+    reader.next(r);
+    FAIL("an event longer than the file was read");
+  } catch (const std::runtime_error& e) {
+    const std::string msg = e.what();
+    CHECK_THAT(msg, Catch::Contains("truncated"));
+    CHECK_THAT(msg, !Catch::Contains("needs -"));  // no overflowed, negative size
+    CHECK_THAT(msg, Catch::Contains("needs 21474836"));
+  }
+}
+
 TEST_CASE("LCM log: garbage and wrong payload types are errors, a missing file too", "[lcm][log]") {
   const auto path = temp_log("garbage.lcmlog");
   std::ofstream(path) << "this is not an LCM log, but long enough to hold a header";
