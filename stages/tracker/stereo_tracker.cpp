@@ -45,10 +45,14 @@ void StereoTracker::reset() {
   prev_pyr_.clear();
 }
 
-cv::Mat StereoTracker::prepare(const cv::Mat& img) const {
-  if (img.type() != CV_8UC1) throw std::invalid_argument("StereoTracker: images must be 8-bit gray");
+cv::Mat StereoTracker::prepare(const cv::Mat& img, const char* which, int64_t t_ns) const {
+  const std::string at = "frame at t = " + std::to_string(t_ns / 1000000000) + "." +
+                         std::to_string(1000000000 + t_ns % 1000000000).substr(1) + " s, " + which + " image";
+  if (img.type() != CV_8UC1) throw std::invalid_argument(at + ": must be 8-bit gray");
   if (cam0_->width() > 0 && (img.cols != cam0_->width() || img.rows != cam0_->height()))
-    throw std::invalid_argument("StereoTracker: image size differs from the calibration's");
+    throw std::invalid_argument(at + " is " + std::to_string(img.cols) + "x" + std::to_string(img.rows) +
+                                " but the camera calibration says " + std::to_string(cam0_->width()) + "x" +
+                                std::to_string(cam0_->height()) + " (image_width/image_height of the camera file)");
   if (!clahe_) return img;
   cv::Mat out;
   clahe_->apply(img, out);
@@ -356,7 +360,7 @@ void label_features(const cv::Mat& labels, std::vector<TrackedFeature>* features
 }  // namespace
 
 TrackedFrame StereoTracker::process(const StereoFrame& frame, std::optional<Eigen::Matrix3d> R_prev_curr_cam0) {
-  const cv::Mat left = prepare(frame.left);
+  const cv::Mat left = prepare(frame.left, "left", frame.t_ns);
   const bool stereo = !frame.right.empty();
   if (!frame.labels.empty() && frame.labels.size() != frame.left.size())
     throw std::invalid_argument("StereoTracker: label image size differs from the left image");
@@ -390,7 +394,7 @@ TrackedFrame StereoTracker::process(const StereoFrame& frame, std::optional<Eige
   }
   if (!frame.labels.empty()) label_features(frame.labels, &out.features);
 
-  if (stereo && !tracks.empty()) match_stereo(curr, prepare(frame.right), &tracks, &out);
+  if (stereo && !tracks.empty()) match_stereo(curr, prepare(frame.right, "right", frame.t_ns), &tracks, &out);
   else
     for (Track& t : tracks) t.stereo_offset.x = std::numeric_limits<float>::quiet_NaN();
 

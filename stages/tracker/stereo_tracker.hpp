@@ -57,7 +57,8 @@ class StereoTracker {
     AffineWarp warp;                              ///< where `patch` lay in the last frame
   };
 
-  cv::Mat prepare(const cv::Mat& img) const;
+  /// Checks type and size against the calibration (errors name the frame time and which image).
+  cv::Mat prepare(const cv::Mat& img, const char* which, int64_t t_ns) const;
   void pyramid(const cv::Mat& img, Pyramid* pyr) const;
   std::vector<Track> track_temporal(const Pyramid& curr, const std::optional<Eigen::Matrix3d>& R_prev_curr,
                                     std::vector<cv::Point2f>* prev_px, TrackerStats* stats) const;

@@ -478,3 +478,16 @@ TEST_CASE("StereoTracker: CLAHE recovers features in a dark low-contrast image",
   CHECK(on >= 1.2 * off);
   CHECK(on >= 80);
 }
+
+TEST_CASE("StereoTracker: an image of the wrong size is an error naming the frame time and both sizes", "[tracker]") {
+  PinholeRadtanCamera::Params p;
+  p.width = 752, p.height = 480, p.fx = 458, p.fy = 457, p.cx = 367, p.cy = 248;
+  StereoTracker tracker(TrackerOptions{}, std::make_shared<const PinholeRadtanCamera>(p));
+  StereoFrame f;
+  f.t_ns = 1'403'715'273'262'142'976;
+  f.left = cv::Mat(480, 640, CV_8UC1, cv::Scalar(128));
+  CHECK_THROWS_WITH(tracker.process(f), Catch::Contains("t = 1403715273.262142976 s") && Catch::Contains("left") &&
+                                            Catch::Contains("640x480") && Catch::Contains("752x480"));
+  f.left = cv::Mat(480, 752, CV_16UC1, cv::Scalar(128));
+  CHECK_THROWS_WITH(tracker.process(f), Catch::Contains("8-bit gray"));
+}
