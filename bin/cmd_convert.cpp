@@ -23,6 +23,12 @@ struct ConvertOptions {
 };
 
 void run_convert(const ConvertOptions& o) {
+  // Checked before anything is written: a conversion must not run for minutes and fail on the rename.
+  namespace fs = std::filesystem;
+  if (fs::is_directory(o.out)) throw CommandError("--out " + o.out + " is a directory; give the log file's name", 2);
+  const fs::path parent = fs::path(o.out).parent_path();
+  if (!parent.empty() && !fs::is_directory(parent))
+    throw CommandError("--out " + o.out + ": the folder " + parent.string() + " does not exist", 2);
   auto source = o.input.open();
   const std::string partial = o.out + ".partial";
   int64_t frames = 0, imu = 0, gt = 0;

@@ -33,7 +33,8 @@ ConfigReader::ConfigReader(const std::string& path) : path_(path) {
   try {
     fs_.open(path, cv::FileStorage::READ);
   } catch (const cv::Exception& e) {
-    throw ConfigError(path, "", "not a valid OpenCV yaml file: " + e.msg);
+    // e.err is OpenCV's own short description (e.msg adds its source file and function).
+    throw ConfigError(path, "", "not a valid OpenCV yaml file (" + e.err + "); a VINS-Fusion config starts with %YAML:1.0");
   }
   if (!fs_.isOpened()) throw ConfigError(path, "", "cannot open as an OpenCV yaml file");
   // OpenCV's map keeps every entry while fs_[key] finds the first, so a repeat is seen here.

@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # `dynavins run` never passes off an incomplete run as a good one:
 #  - an empty log estimates no pose: exit 1, summary.json ok: false, the error says why;
-#  - SIGINT mid-run: exit 130, summary.json interrupted: true, and `compare` lists the run as interrupted.
+#  - SIGINT mid-run: exit 130, summary.json interrupted: true, and `compare` lists the run as interrupted;
+#  - `convert --out EXISTING_DIR` fails before writing; a non-yaml config is an error naming the file.
 # Usage: test_run_failures.sh DYNAVINS SHARED_DIR
 set -euo pipefail
 bin=$1 shared=$2
@@ -16,8 +17,10 @@ cat "$tmp/log" | tail -3
 grep -q 'no pose was estimated' "$tmp/log" || { echo "FAIL: the error does not say no pose was estimated"; exit 1; }
 grep -q '"ok": false' "$tmp/empty/summary.json" || { echo "FAIL: summary.json of the empty run says ok"; exit 1; }
 
-"$bin" run --config "$config" --euroc "$shared/data/euroc_v1_01_micro" --rate 1 --out "$tmp/cut" > "$tmp/log" 2>&1 & pid=$!
-sleep 2.5
+"$bin" run --config "$config" --euroc "$shared/data/euroc_v1_01_micro" --rate 0.5 --out "$tmp/cut" > "$tmp/log" 2>&1 & pid=$!
+# SIGINT once the run is under way (its first poses are written), never before its handler is installed.
+for _ in $(seq 200); do [ -s "$tmp/cut/odometry.tum.partial" ] && break; sleep 0.1; done
+sleep 0.5
 kill -INT $pid
 rc=0; wait $pid || rc=$?
 tail -3 "$tmp/log"
@@ -25,4 +28,18 @@ tail -3 "$tmp/log"
 grep -q '"interrupted": true' "$tmp/cut/summary.json" || { echo "FAIL: summary.json does not say interrupted"; exit 1; }
 "$bin" compare "$tmp/cut" --gt "$tmp/cut/odometry.tum" > "$tmp/compare" 2>&1 || true
 grep -q 'cut (interrupted)' "$tmp/compare" || { cat "$tmp/compare"; echo "FAIL: compare does not list the run as interrupted"; exit 1; }
+# convert --out an existing directory fails before writing anything.
+mkdir -p "$tmp/existing"
+rc=0; "$bin" convert --euroc "$shared/data/euroc_v1_01_micro" --out "$tmp/existing" > "$tmp/log" 2>&1 || rc=$?
+[ "$rc" -eq 2 ] || { cat "$tmp/log"; echo "FAIL: convert --out DIR exited $rc, expected 2"; exit 1; }
+grep -q 'is a directory' "$tmp/log" || { cat "$tmp/log"; echo "FAIL: the error does not say --out is a directory"; exit 1; }
+[ -z "$(ls -A "$tmp/existing")" ] && [ ! -e "$tmp/existing.partial" ] || { echo "FAIL: convert wrote something"; exit 1; }
+
+# A config that is not yaml names the file and says what a config looks like, without OpenCV's internals.
+printf 'this is: [not yaml\n' > "$tmp/bad.yaml"
+rc=0; "$bin" run --config "$tmp/bad.yaml" --euroc "$shared/data/euroc_v1_01_micro" --out "$tmp/bad" > "$tmp/log" 2>&1 || rc=$?
+cat "$tmp/log" | tail -2
+[ "$rc" -eq 2 ] || { echo "FAIL: a non-yaml config exited $rc, expected 2"; exit 1; }
+grep -q "$tmp/bad.yaml" "$tmp/log" && grep -q '%YAML:1.0' "$tmp/log" || { echo "FAIL: the error does not name the file"; exit 1; }
+grep -q 'in function' "$tmp/log" && { echo "FAIL: OpenCV's raw message leaks"; exit 1; }
 echo ok
