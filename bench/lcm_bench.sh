@@ -4,7 +4,9 @@
 #  1. rate 0, without and with --lcm-url (lcm-logger subscribed), alternated REPS times: wall time ratio;
 #  2. latency from an input's arrival to its pose being published (IMU-rate and window pose), from
 #     summary.json (mean, p99);
-#  3. `live` at 1x, fed by lcm-logplayer: frames dropped, IMU-pose latency.
+#  3. `live` at 1x, fed by lcm-logplayer, REPS times with the default real-time scheduling of the light
+#     threads (--rt-priority 10) and without it (0), alternated: frames dropped, IMU samples received,
+#     resets, IMU-pose latency.
 # Writes bench/results/lcm.md. Usage: bench/lcm_bench.sh [SCENE_DIR] [REPS]
 set -euo pipefail
 cd "$(dirname "$0")/.."
@@ -29,19 +31,23 @@ for i in $(seq "$reps"); do
   "$bin" run --config "$config" --log "$scene/sensors.lcmlog" --lcm-url "$url" --out "lcm-$i" > /dev/null 2>&1
   kill -INT $logger; wait $logger || true
 done
-"$bin" live --config "$config" --lcm-url "$url" --out live > live.log 2>&1 & live=$!
-sleep 1.5
-lcm-logplayer --lcm-url="$url" "$scene/sensors.lcmlog" > /dev/null
-sleep 1.5
-kill -INT $live; wait $live
+for i in $(seq "$reps"); do
+  for rt in 10 0; do
+    "$bin" live --config "$config" --lcm-url "$url" --rt-priority $rt --out "live-rt$rt-$i" > "live-rt$rt-$i.log" 2>&1 & live=$!
+    sleep 1.5
+    lcm-logplayer --lcm-url="$url" "$scene/sensors.lcmlog" > /dev/null
+    sleep 1.5
+    kill -INT $live; wait $live
+  done
+done
 NS
 /usr/bin/python3 - "$reps" "$scene" "$out" <<'PY'
-import json, statistics, sys
+import json, os, statistics, sys
 reps, scene, out = int(sys.argv[1]), sys.argv[2], sys.argv[3]
 load = lambda p: json.load(open(p))
 plain = [load(f"plain-{i}/summary.json") for i in range(1, reps + 1)]
 lcm = [load(f"lcm-{i}/summary.json") for i in range(1, reps + 1)]
-live = load("live/summary.json")
+live = {rt: [load(f"live-rt{rt}-{i}/summary.json") for i in range(1, reps + 1)] for rt in (10, 0)}
 wp, wl = [s["wall_s"] for s in plain], [s["wall_s"] for s in lcm]
 ratio = statistics.median(wl) / statistics.median(wp)
 lat = lambda s, k: s["lcm"][k]
@@ -61,17 +67,25 @@ rows = [
     "| latency, input arrival -> published [ms] | mean | p99 | max |",
     "|---|---|---|---|",
 ]
-for name, s in [("rate 0 run", lcm[0]), ("live at 1x", live)]:
-    for k, label in [("imu_pose_latency_ms", "IMU-rate pose"), ("window_pose_latency_ms", "window pose (frame -> pose)")]:
-        l = s["lcm"][k]
-        rows.append(f"| {name}: {label} | {l['mean']:.3f} | {l['p99']:.3f} | {l['max']:.3f} |")
+for k, label in [("imu_pose_latency_ms", "IMU-rate pose"), ("window_pose_latency_ms", "window pose (frame -> pose)")]:
+    l = lcm[0]["lcm"][k]
+    rows.append(f"| rate 0 run: {label} | {l['mean']:.3f} | {l['p99']:.3f} | {l['max']:.3f} |")
+for rt, runs in live.items():
+    for i, s in enumerate(runs, 1):
+        for k, label in [("imu_pose_latency_ms", "IMU-rate pose"), ("window_pose_latency_ms", "window pose")]:
+            l = s["lcm"][k]
+            rows.append(f"| live at 1x, --rt-priority {rt}, run {i}: {label} | {l['mean']:.3f} | {l['p99']:.3f} | {l['max']:.3f} |")
+rows += ["", "| `live` at 1x | frames in | dropped | IMU samples | resets | tracking | publish dropped | real-time threads | ATE SE3 [m] |",
+         "|---|---|---|---|---|---|---|---|---|"]
+for rt, runs in live.items():
+    for i, s in enumerate(runs, 1):
+        rows.append(f"| --rt-priority {rt}, run {i} | {s['frames_in']} | {s['frames_dropped']} | {s['imu_samples']} | {s['resets']} | "
+                    f"{s['frames_tracking']} | {s['lcm']['dropped']} | {s.get('realtime_threads', 0)} | {s.get('ate_se3_m', float('nan')):.4f} |")
 rows += [
-    "",
-    f"`live` at 1x: {live['frames_in']} frames in, {live['frames_dropped']} dropped, {live['frames_tracking']} tracking, "
-    f"publish queue dropped {live['lcm']['dropped']}, ATE {live.get('ate_se3_m', float('nan')):.4f} m.",
     "",
     "The IMU-rate latency is measured from the moment the IMU stage takes the sample (its wait in the IMU",
     "queue is in the stage's wait statistics); the window-pose latency from the moment the tracker takes the frame.",
+    f"Load on the machine while this ran (1-min load average at the end): {os.getloadavg()[0]:.1f} on {os.cpu_count()} cores.",
 ]
 open(out, "w").write("\n".join(rows) + "\n")
 print("\n".join(rows))

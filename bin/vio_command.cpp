@@ -36,6 +36,11 @@ void VioCommandOptions::add_options(CLI::App& cmd, const std::string& lcm_url_he
       ->check(CLI::IsMember({"off", "all", "switchable", "dynavins"}))
       ->capture_default_str();
   cmd.add_option("--vocabulary", vocabulary, "Vocabulary tree for place recognition (default: the shipped one)");
+  cmd.add_option("--rt-priority", realtime_priority,
+                 "Real-time runs: SCHED_FIFO priority of the IMU and publisher threads when the process may (root, "
+                 "CAP_SYS_NICE or an rtprio limit), so the IMU-rate pose is not held up on a busy machine; 0 = off")
+      ->check(CLI::Range(0, 99))
+      ->capture_default_str();
   cmd.add_option("--channel", channels,
                  "Rename an output channel: --channel key=NAME (keys: pose_imu, pose, pose_corrected, features, status, stats, "
                  "loops, path)");
@@ -52,6 +57,7 @@ pipeline::VioRunOptions VioCommandOptions::load(double rate) const {
     opt.rate = rate;
     opt.imu_rate_hz = imu_rate_hz;
     opt.gyro_prediction = gyro_prediction;
+    opt.realtime_priority = realtime_priority;
     opt.lcm_url = lcm_url;
     for (const std::string& c : channels) opt.channels.set(c);
     opt.loop_mode = loop::parse_loop_mode(loop);

@@ -28,9 +28,10 @@ struct VioCommandOptions {
   std::vector<std::string> channels;  ///< output channel overrides, key=NAME
   std::string loop = "dynavins";      ///< off | all | switchable | dynavins
   std::string vocabulary;             ///< empty: the default vocabulary (default_vocabulary_path())
+  int realtime_priority = pipeline::VioRunOptions{}.realtime_priority;  ///< real time: IMU + publisher
 
   /// Adds --config, --out, --ba, --mono, --gyro-prediction, --set, --imu-rate, --lcm-url, --channel,
-  /// --loop, --vocabulary.
+  /// --loop, --vocabulary, --rt-priority.
   void add_options(CLI::App& cmd, const std::string& lcm_url_help);
   /// The run's options (config loaded, overrides applied, checked); CommandError (exit 2) naming the
   /// problem otherwise.

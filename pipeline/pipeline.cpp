@@ -1,5 +1,11 @@
 #include "pipeline/pipeline.hpp"
 
+#include <pthread.h>
+#include <sched.h>
+
+#include <cstring>
+#include <stdexcept>
+
 #include <spdlog/spdlog.h>
 
 #include "pipeline/interrupt.hpp"
@@ -34,6 +40,13 @@ void Pipeline::fail(const std::string& thread, const std::string& what) {
 
 void Pipeline::launch(StageRecord& rec, std::function<void()> body, std::function<void()> close_outputs) {
   bodies_.push_back([this, &rec, body = std::move(body), close_outputs = std::move(close_outputs)]() {
+    if (rec.realtime_priority > 0) {
+      sched_param param{};
+      param.sched_priority = rec.realtime_priority;
+      const int err = pthread_setschedparam(pthread_self(), SCHED_FIFO, &param);
+      (err == 0 ? realtime_granted_ : realtime_refused_).fetch_add(1, std::memory_order_relaxed);
+      if (err != 0) spdlog::debug("{}: no real-time scheduling ({}); runs as a normal thread", rec.name, std::strerror(err));
+    }
     try {
       body();
     } catch (const std::exception& e) {
@@ -56,6 +69,16 @@ void Pipeline::add_source(std::string name, std::function<void(const StopFlag&)>
                           std::function<void()> close_outputs) {
   StageRecord& rec = add_record(std::move(name));
   launch(rec, [this, body = std::move(body)]() { body(stop_); }, std::move(close_outputs));
+}
+
+void Pipeline::set_thread_realtime(const std::string& name, int priority) {
+  if (priority < 1 || priority > 99) throw std::invalid_argument("set_thread_realtime: priority must be in [1, 99]");
+  for (auto& r : records_)
+    if (r->name == name) {
+      r->realtime_priority = priority;
+      return;
+    }
+  throw std::invalid_argument("set_thread_realtime: no thread named '" + name + "'");
 }
 
 RunReport Pipeline::run() {

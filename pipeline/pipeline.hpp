@@ -89,6 +89,16 @@ class Pipeline {
   template <typename Stage, typename Queue, typename Emit>
   void add_stage(std::string name, Stage& stage, Queue& input, Emit emit, std::function<void()> close_outputs);
 
+  /// Runs the named source or stage under the real-time FIFO scheduler at `priority` (1-99) when the
+  /// process may (root, CAP_SYS_NICE or an rtprio limit; otherwise it stays a normal thread and the
+  /// summary says so). Real-time runs use it for the light, latency-critical threads (IMU propagation,
+  /// publisher), so that a busy machine does not hold up the IMU-rate pose. Call before run().
+  void set_thread_realtime(const std::string& name, int priority);
+
+  /// Threads that asked for real-time scheduling and got it / did not (after run()).
+  int realtime_threads() const { return realtime_granted_.load(std::memory_order_relaxed); }
+  int realtime_refused() const { return realtime_refused_.load(std::memory_order_relaxed); }
+
   /// Starts every thread and blocks until all have ended. Watches SIGINT (see interrupt.hpp).
   RunReport run();
 
@@ -107,6 +117,7 @@ class Pipeline {
     LatencyHistogram wait;
     std::atomic<uint64_t> processed{0};
     std::atomic<bool> finished{false};
+    int realtime_priority = 0;  ///< set_thread_realtime(); applied by the thread itself when it starts
   };
 
   StageRecord& add_record(std::string name);
@@ -128,6 +139,8 @@ class Pipeline {
   std::vector<std::function<void()>> bodies_;  // filled by add_*, started by run()
   std::vector<std::thread> threads_;
   std::atomic<int> running_{0};
+  std::atomic<int> realtime_granted_{0};
+  std::atomic<int> realtime_refused_{0};
   std::mutex error_mutex_;  // error path only, never the data path
   std::string failed_thread_;
   std::string error_;

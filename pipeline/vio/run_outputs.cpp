@@ -264,6 +264,8 @@ std::string summaryJson(const VioRunResult& run, const RunDescription& what, con
   j << "},\n";
   // false at rate 0: each window solve was bounded by max_num_iterations alone (machine-independent).
   j << "  \"solver_time_budget\": " << (run.solver_time_budget ? "true" : "false") << ",\n";
+  j << "  \"realtime_threads\": " << run.realtime_threads << ",\n";
+  j << "  \"realtime_threads_refused\": " << run.realtime_refused << ",\n";
   j << "  \"ba_solves\": " << totals.ba_ms.size() << ",\n";
   j << "  \"ba_ms_mean\": " << num(mean(totals.ba_ms)) << ",\n";
   j << "  \"ba_ms_p95\": " << num(percentile(totals.ba_ms, 95)) << ",\n";

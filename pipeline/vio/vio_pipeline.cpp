@@ -227,8 +227,16 @@ VioRunResult runVio(io::SensorSource& source, const VioRunOptions& opt, const Vi
     if (writer_pub) writer_pub->close();
   });
   if (publisher) p.add_stage("publisher", *publisher, *publish_q, NoOutput{}, {});
+  // The source too: live, it drains the sensor socket, and a starved reader loses IMU packets in the kernel.
+  if (opt.realTime() && opt.realtime_priority > 0) {
+    p.set_thread_realtime("replay", opt.realtime_priority);
+    p.set_thread_realtime("imu", opt.realtime_priority);
+    if (publisher) p.set_thread_realtime("publisher", opt.realtime_priority);
+  }
 
   result.report = p.run();
+  result.realtime_threads = p.realtime_threads();
+  result.realtime_refused = p.realtime_refused();
   if (publisher) {
     result.publisher = publisher->stats();
     for (const auto& q : result.report.queues)

@@ -75,6 +75,10 @@ struct VioRunOptions {
   std::string vocabulary;
   /// Keyframes waiting for the loop closer; rate 0 blocks (lossless), real time drops (counted).
   std::size_t keyframe_queue = 64;
+  /// Real-time runs only: SCHED_FIFO priority of the source (sensor input), IMU and publisher threads, all
+  /// light, when the process may (0 = off): on a busy machine the IMU-rate pose is then not held up behind
+  /// the tracker and estimator, and a live source keeps draining its socket (bench/lcm_bench.sh).
+  int realtime_priority = 10;
 };
 
 /// Where the results go. Threaded: `estimate` is called on the writer thread, `tracked` on the tracker
@@ -106,6 +110,9 @@ struct VioRunResult {
   /// Whether the config's max_solver_time bounded the window solves (paced runs); at rate 0 only the
   /// iteration budget does, so the result does not depend on the machine's speed or load.
   bool solver_time_budget = true;
+  /// Threads that asked for real-time scheduling (VioRunOptions::realtime_priority) and got it / were refused.
+  int realtime_threads = 0;
+  int realtime_refused = 0;
   int64_t frames_gyro_predicted = 0;
   int64_t frames_gyro_unpredicted = 0;
   int64_t features_gyro_predicted = 0;

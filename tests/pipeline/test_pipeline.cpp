@@ -4,6 +4,9 @@
 #include <thread>
 #include <vector>
 
+#include <pthread.h>
+#include <sched.h>
+
 #include <catch2/catch.hpp>
 
 #include "pipeline/interrupt.hpp"
@@ -62,7 +65,47 @@ struct Thrower {
   }
 };
 
+/// Records the scheduling policy of the thread that runs it.
+struct PolicyProbe {
+  int policy = -1;
+  int priority = -1;
+  void process(int) {
+    sched_param param{};
+    pthread_getschedparam(pthread_self(), &policy, &param);
+    priority = param.sched_priority;
+  }
+};
+
 }  // namespace
+
+TEST_CASE("Pipeline: set_thread_realtime runs that thread under SCHED_FIFO when allowed, and says so", "[pipeline]") {
+  Pipeline p;
+  auto& a = p.add_queue<int>("a", 4, Backpressure::Block);
+  auto& b = p.add_queue<int>("b", 4, Backpressure::Block);
+  p.add_source(
+      "source", [&](const StopFlag&) { a.push(1), b.push(1); },
+      [&] {
+        a.close();
+        b.close();
+      });
+  PolicyProbe fast, normal;
+  p.add_stage("fast", fast, a, NoOutput{}, {});
+  p.add_stage("normal", normal, b, NoOutput{}, {});
+  CHECK_THROWS_WITH(p.set_thread_realtime("nonexistent", 10), Catch::Contains("no thread named 'nonexistent'"));
+  CHECK_THROWS_WITH(p.set_thread_realtime("fast", 0), Catch::Contains("[1, 99]"));
+  p.set_thread_realtime("fast", 7);
+  REQUIRE(p.run().ok);
+
+  // Granted (root, CAP_SYS_NICE or an rtprio limit) or refused, it is counted, and the run went on.
+  REQUIRE(p.realtime_threads() + p.realtime_refused() == 1);
+  if (p.realtime_threads() == 1) {
+    CHECK(fast.policy == SCHED_FIFO);
+    CHECK(fast.priority == 7);
+  } else {
+    CHECK(fast.policy == SCHED_OTHER);
+  }
+  CHECK(normal.policy == SCHED_OTHER);
+}
 
 TEST_CASE("Pipeline: a chain loses and reorders nothing, finish() flushes, queues drain", "[pipeline]") {
   Pipeline p;
