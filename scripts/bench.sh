@@ -5,10 +5,11 @@
 #   full  (make bench):       every scenario of bench/scenarios at full length (40-85 s), and `none`
 #                             and `high` again at noise seeds 12 to 17 -> bench/results/
 #   quick (make bench-quick): `none` and `high` cut to 20 s (cached as NAME-20s) -> bench/results/quick/
-#   loop-only:                only the loop-closure scenes and their loop-mode runs -> bench/results/loop/
-# Loop scenes (loop_scenes below) also run with --loop all and --loop switchable (stereo and mono,
-# DynaVINS BA; the plain runs are --loop dynavins, whose odometry.tum is --loop off's), and one
-# --loop off run (stereo) for the estimator's speed without the loop thread.
+#   loop-only:                only the loop-closure scenes, DynaVINS BA, their loop-mode runs -> bench/results/loop/
+# Loop scenes (loop_scenes below) also run with --loop all and --loop switchable (DynaVINS BA; stereo
+# and mono, temporal_static stereo only, to keep the bench's time), beside the plain runs, which are
+# --loop dynavins and whose odometry.tum is --loop off's; and one --loop off run (e_shape stereo) for
+# the estimator's speed without the loop thread.
 # Every run: `dynavins run --rate 0` (lossless replay; at rate 0 the solves are bounded by iterations
 # only), so accuracy does not depend on machine load. A failed run is recorded as failed
 # (manifest + report) and the bench goes on; it exits 1 at the end when a scene or run crashed.
@@ -37,6 +38,7 @@ python=${PYTHON:-/usr/bin/python3}
 [ -x "$bin" ] || { echo "bench: $bin not found (make build first)" >&2; exit 1; }
 
 loop_scenes=(temporal_static e_shape revisit)
+bas=(huber dynavins)
 if [ "$quick" = 1 ]; then
   scenarios=(none high)
   sim_args=(--duration 20)
@@ -44,7 +46,8 @@ if [ "$quick" = 1 ]; then
   out=${out:-bench/results/quick}
   extra_seeds=()
 elif [ "$quick" = 2 ]; then
-  scenarios=("${loop_scenes[@]}")
+  scenarios=(e_shape revisit temporal_static)
+  bas=(dynavins)  # the loop table compares loop modes over the DynaVINS odometry
   sim_args=()
   suffix=""
   out=${out:-bench/results/loop}
@@ -86,12 +89,15 @@ ram_gb=$(awk '/MemTotal/ {printf "%.1f", $2/1048576}' /proc/meminfo)
 printf 'kind\tscenario\tmode\tba\tvariant\tstatus\twall_s\tdir\tcommand\n' > "$manifest"
 
 # --- progress ---------------------------------------------------------------------------------
-runs_per_scene=4
-loop_runs_per_scene=4  # all, switchable x stereo, mono
+runs_per_scene=$((2 * ${#bas[@]}))
+loop_sensors=(stereo mono)
+loop_sensors_of() { if [ "$1" = temporal_static ]; then echo stereo; else echo "${loop_sensors[@]}"; fi; }
 is_loop_scene() { local s; for s in "${loop_scenes[@]}"; do [ "$s" = "$1" ] && return 0; done; return 1; }
 n_loop=0
-for sc in "${scenarios[@]}"; do is_loop_scene "$sc" && n_loop=$((n_loop + 1)); done
-total=$(( (${#scenarios[@]} + 2 * ${#extra_seeds[@]}) * (1 + runs_per_scene) + n_loop * loop_runs_per_scene ))  # scenes x (generate + runs), loop modes
+for sc in "${scenarios[@]}"; do
+  if is_loop_scene "$sc"; then for m in $(loop_sensors_of "$sc"); do n_loop=$((n_loop + 2)); done; fi
+done
+total=$(( (${#scenarios[@]} + 2 * ${#extra_seeds[@]}) * (1 + runs_per_scene) + n_loop ))  # scenes x (generate + runs), loop modes
 for sc in "${scenarios[@]}"; do [ "$sc" = e_shape ] && total=$((total + 1)); done  # --loop off (loop_speed_scene)
 [ "$quick" != 2 ] && total=$((total + 2))  # ablation, overlay
 [ -x "$tracker_bin" ] && [ "$quick" != 2 ] && total=$((total + 1))
@@ -148,7 +154,7 @@ scene_runs() {
     generated=0
   fi
   for mode in stereo mono; do
-    for ba in huber dynavins; do
+    for ba in "${bas[@]}"; do
       if [ "$generated" = 1 ]; then run_one "$sc" "$mode" "$ba" "$variant"; else not_run "$sc" "$mode" "$ba" "$variant"; fi
     done
   done
@@ -163,7 +169,7 @@ for sc in "${scenarios[@]}"; do
     [ "$sc" = "$ablation_scene" ] && run_one "$sc" stereo dynavins nomomentum --set momentum_on=0
     # Loop closure (paper IV): the baselines' trajectory.tum beside the plain run's (--loop dynavins)
     if is_loop_scene "$sc"; then
-      for mode in stereo mono; do
+      for mode in $(loop_sensors_of "$sc"); do
         for lm in all switchable; do run_one "$sc" "$mode" dynavins "loop$lm" --loop "$lm"; done
       done
       [ "$sc" = "$loop_speed_scene" ] && run_one "$sc" stereo dynavins loopoff --loop off
@@ -171,7 +177,7 @@ for sc in "${scenarios[@]}"; do
   else
     [ "$sc" = "$ablation_scene" ] && not_run "$sc" stereo dynavins nomomentum
     if is_loop_scene "$sc"; then
-      for mode in stereo mono; do
+      for mode in $(loop_sensors_of "$sc"); do
         for lm in all switchable; do not_run "$sc" "$mode" dynavins "loop$lm"; done
       done
       [ "$sc" = "$loop_speed_scene" ] && not_run "$sc" stereo dynavins loopoff
