@@ -581,7 +581,7 @@ def loop_group_lines(runs):
             if not groups:
                 lines.append(f"- `{s}` {tag}: no group with loops")
                 continue
-            t0 = min(int(r["group_first_t_ns"]) for r in read_loops_csv(run.dir) if r.get("group_first_t_ns"))
+            t0 = run.t_gt[0] * 1e9 if len(run.t_gt) else 0.0  # group times from the sequence's start
             parts = []
             for g in groups:
                 hs = "; ".join(f"H{k}: {v['loops']} loops, {v['true']} true, w {v['weight']:.2f}"
