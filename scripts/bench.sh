@@ -5,7 +5,8 @@
 #   full  (make bench):       every scenario of bench/scenarios at full length (40-85 s), and `none`
 #                             and `high` again at noise seeds 12 to 17 -> bench/results/
 #   quick (make bench-quick): `none` and `high` cut to 20 s (cached as NAME-20s) -> bench/results/quick/
-#   loop-only:                only the loop-closure scenes, DynaVINS BA, their loop-mode runs -> bench/results/loop/
+#   loop-only:                only the loop-closure scenes, DynaVINS BA, their loop-mode runs, mono on
+#                             revisit only, no --loop off run (~13 runs) -> bench/results/loop/
 # Loop scenes (loop_scenes below) also run with --loop all and --loop switchable (DynaVINS BA; stereo
 # and mono, temporal_static stereo only, to keep the bench's time), beside the plain runs, which are
 # --loop dynavins and whose odometry.tum is --loop off's; and one --loop off run (e_shape stereo) for
@@ -91,14 +92,18 @@ printf 'kind\tscenario\tmode\tba\tvariant\tstatus\twall_s\tdir\tcommand\n' > "$m
 # --- progress ---------------------------------------------------------------------------------
 runs_per_scene=$((2 * ${#bas[@]}))
 loop_sensors=(stereo mono)
-loop_sensors_of() { if [ "$1" = temporal_static ]; then echo stereo; else echo "${loop_sensors[@]}"; fi; }
+# --loop-only keeps to the runs the loop table needs most: mono (odometry that drifts) on revisit only
+loop_sensors_of() {
+  if [ "$1" = temporal_static ] || { [ "$quick" = 2 ] && [ "$1" != revisit ]; }; then echo stereo; else echo "${loop_sensors[@]}"; fi
+}
 is_loop_scene() { local s; for s in "${loop_scenes[@]}"; do [ "$s" = "$1" ] && return 0; done; return 1; }
 n_loop=0
 for sc in "${scenarios[@]}"; do
   if is_loop_scene "$sc"; then for m in $(loop_sensors_of "$sc"); do n_loop=$((n_loop + 2)); done; fi
 done
 total=$(( (${#scenarios[@]} + 2 * ${#extra_seeds[@]}) * (1 + runs_per_scene) + n_loop ))  # scenes x (generate + runs), loop modes
-for sc in "${scenarios[@]}"; do [ "$sc" = e_shape ] && total=$((total + 1)); done  # --loop off (loop_speed_scene)
+[ "$quick" = 2 ] && total=$(( ${#scenarios[@]} + n_loop / 2 + n_loop ))  # generate, one plain run per sensor, loop modes
+[ "$quick" != 2 ] && for sc in "${scenarios[@]}"; do [ "$sc" = e_shape ] && total=$((total + 1)); done  # --loop off
 [ "$quick" != 2 ] && total=$((total + 2))  # ablation, overlay
 [ -x "$tracker_bin" ] && [ "$quick" != 2 ] && total=$((total + 1))
 step=0
@@ -153,7 +158,7 @@ scene_runs() {
     echo "bench: generating $scene_cache failed (see $log); its runs are recorded as failed" >&2
     generated=0
   fi
-  for mode in stereo mono; do
+  for mode in $([ "$quick" = 2 ] && loop_sensors_of "$sc" || echo stereo mono); do
     for ba in "${bas[@]}"; do
       if [ "$generated" = 1 ]; then run_one "$sc" "$mode" "$ba" "$variant"; else not_run "$sc" "$mode" "$ba" "$variant"; fi
     done
@@ -172,7 +177,7 @@ for sc in "${scenarios[@]}"; do
       for mode in $(loop_sensors_of "$sc"); do
         for lm in all switchable; do run_one "$sc" "$mode" dynavins "loop$lm" --loop "$lm"; done
       done
-      [ "$sc" = "$loop_speed_scene" ] && run_one "$sc" stereo dynavins loopoff --loop off
+      [ "$sc" = "$loop_speed_scene" ] && [ "$quick" != 2 ] && run_one "$sc" stereo dynavins loopoff --loop off
     fi
   else
     [ "$sc" = "$ablation_scene" ] && not_run "$sc" stereo dynavins nomomentum
@@ -180,7 +185,7 @@ for sc in "${scenarios[@]}"; do
       for mode in $(loop_sensors_of "$sc"); do
         for lm in all switchable; do not_run "$sc" "$mode" dynavins "loop$lm"; done
       done
-      [ "$sc" = "$loop_speed_scene" ] && not_run "$sc" stereo dynavins loopoff
+      [ "$sc" = "$loop_speed_scene" ] && [ "$quick" != 2 ] && not_run "$sc" stereo dynavins loopoff
     fi
   fi
 done
