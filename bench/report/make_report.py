@@ -635,7 +635,7 @@ def plot_loop_edges(run, out_png):
     rows = read_loops_csv(run.dir)
     if len(t) < 2:
         return False
-    fig, ax = plt.subplots(figsize=(7, 5))
+    fig, ax = plt.subplots(figsize=(8, 4.5))
     i, j = associate(t, run.t_gt)
     if len(i) >= 3:
         s_, r_, tr = umeyama(xyz[i], run.xyz_gt[j])
@@ -653,11 +653,17 @@ def plot_loop_edges(run, out_png):
             a, b = at(int(r["query_t_ns"])), at(int(r["match_t_ns"]))
             ax.plot([a[0], b[0]], [a[1], b[1]], color=color, lw=0.8, alpha=0.7, label=name if first else None)
             first = False
-    ax.set_aspect("equal")
+    span = np.ptp(xyz[:, :2], axis=0)
+    if span.min() > 0 and span.max() / span.min() > 3:  # a long thin path: stretch the short axis
+        ax.set_aspect("auto")
+        ax.set_title(f"{run.scenario} {run.mode}: verified loops after the final optimisation (axes not to scale)",
+                     fontsize=9)
+    else:
+        ax.set_aspect("equal")
+        ax.set_title(f"{run.scenario} {run.mode}: verified loops after the final optimisation", fontsize=9)
     ax.set_xlabel("x [m]")
     ax.set_ylabel("y [m]")
-    ax.set_title(f"{run.scenario} {run.mode}: verified loops after the final optimisation")
-    ax.legend(fontsize=7, loc="best")
+    ax.legend(fontsize=7, loc="upper center", bbox_to_anchor=(0.5, -0.15), ncol=4)
     fig.tight_layout()
     fig.savefig(out_png, dpi=110)
     plt.close(fig)
