@@ -57,7 +57,8 @@ SyntheticGraph make_graph(int n) {
   // Odometry: the true relative motion scaled by 1.01, yaw drifting 0.02 deg per keyframe.
   g.odometry.push_back(g.truth[0]);
   for (int k = 1; k < n; ++k) {
-    const RigidPose d = compose(inverse(g.truth[static_cast<std::size_t>(k - 1)]), g.truth[static_cast<std::size_t>(k)]);
+    const RigidPose d =
+        compose(inverse(g.truth[static_cast<std::size_t>(k - 1)]), g.truth[static_cast<std::size_t>(k)]);
     RigidPose next = compose(g.odometry.back(), RigidPose{1.01 * d.p, d.q});
     next.q = quat_from_ypr(yaw_of(next.q) + 0.02 * M_PI / 180.0, pitch_of(next.q), roll_of(next.q));
     g.odometry.push_back(next);
@@ -113,8 +114,8 @@ int main(int argc, char** argv) {
       err[m] = rmse(g, r.poses);
       if (modes[m] == LoopMode::Dynavins) alternations = r.alternations;
     }
-    std::printf("%8d %7zu %11.1f %12.1f %14.1f %12d %10.3f %9.3f %9.3f %9.3f\n", n, g.loops.size(), ms[0], ms[1],
-                ms[2], alternations, rmse(g, g.odometry), err[0], err[1], err[2]);
+    std::printf("%8d %7zu %11.1f %12.1f %14.1f %12d %10.3f %9.3f %9.3f %9.3f\n", n, g.loops.size(), ms[0], ms[1], ms[2],
+                alternations, rmse(g, g.odometry), err[0], err[1], err[2]);
     std::fflush(stdout);
   }
   return 0;

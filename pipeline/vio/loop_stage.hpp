@@ -35,12 +35,12 @@ struct LoopRunSummary {
   int64_t keyframes_dropped = 0;  ///< real time only: the keyframe queue was full (the chain skips them)
   int64_t groups = 0, optimizations = 0;
   double keyframe_ms_mean = 0, keyframe_ms_max = 0;  ///< process() per keyframe, optimisation included
-  double keyframe_ms_p95 = 0;                         ///< 95th percentile of the same
+  double keyframe_ms_p95 = 0;                        ///< 95th percentile of the same
   /// Means per keyframe of its parts: ORB descriptors, bag of words + database query, PnP verification of
   /// the candidates; and the pose-graph optimisation's mean over the optimisations that ran.
   double descriptors_ms_mean = 0, query_ms_mean = 0, verification_ms_mean = 0, optimization_ms_mean = 0;
   double optimization_ms_max = 0;
-  std::size_t memory_bytes = 0;  ///< the keyframe database, no images
+  std::size_t memory_bytes = 0;                       ///< the keyframe database, no images
   std::vector<loop::KeyframeCorrection> corrections;  ///< per keyframe, after the final optimisation
   std::vector<VerifiedLoop> loops;                    ///< every verified loop, in detection order
   std::vector<loop::LoopReportRow> rows;              ///< per loop: group, hypothesis, final weight, used

@@ -112,7 +112,7 @@ TEST_CASE("loop verifier on rendered views: a revisit gives the true relative po
   CHECK(v.inliers >= 30);
   const RelativePoseError e = error_of(v.loop, T_wm, T_wk);
   INFO("T_m^k error " << e.m << " m, " << e.deg << " deg");
-  CHECK(e.m < 0.05);   // the pixel noise of corners at 5-40 m depth, not a cm-level claim
+  CHECK(e.m < 0.05);  // the pixel noise of corners at 5-40 m depth, not a cm-level claim
   CHECK(e.deg < 0.5);
   CHECK(v.loop.query_t_ns == k.t_ns);
   CHECK(v.loop.match_t_ns == m.t_ns);
