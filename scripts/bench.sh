@@ -6,7 +6,7 @@
 #                             and `high` again at noise seeds 12 to 17 -> bench/results/
 #   quick (make bench-quick): `none` and `high` cut to 20 s (cached as NAME-20s) -> bench/results/quick/
 #   loop-only:                only the loop-closure scenes, DynaVINS BA, their loop-mode runs, mono on
-#                             revisit only, no --loop off run (~13 runs) -> bench/results/loop/
+#                             revisit only, no --loop off run (12 runs) -> bench/results/loop/
 # Loop scenes (loop_scenes below) also run with --loop all and --loop switchable (DynaVINS BA; stereo
 # and mono, temporal_static stereo only, to keep the bench's time), beside the plain runs, which are
 # --loop dynavins and whose odometry.tum is --loop off's; and one --loop off run (e_shape stereo) for
