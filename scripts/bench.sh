@@ -1,10 +1,16 @@
 #!/usr/bin/env bash
 # The benchmark suite (issue 6): generates the scenarios once (scripts/cached-sim.sh), runs the
 # estimator on each in every mode that matters, then writes the report (bench/report/make_report.py).
-# Usage: scripts/bench.sh [--quick] [--out DIR]
+# Usage: scripts/bench.sh [--quick | --loop-only] [--out DIR]
 #   full  (make bench):       every scenario of bench/scenarios at full length (40-85 s), and `none`
 #                             and `high` again at noise seeds 12 to 17 -> bench/results/
 #   quick (make bench-quick): `none` and `high` cut to 20 s (cached as NAME-20s) -> bench/results/quick/
+#   loop-only:                only the loop-closure scenes, DynaVINS BA, their loop-mode runs, mono on
+#                             revisit only, no --loop off run (12 runs) -> bench/results/loop/
+# Loop scenes (loop_scenes below) also run with --loop all and --loop switchable (DynaVINS BA; stereo
+# and mono, temporal_static stereo only, to keep the bench's time), beside the plain runs, which are
+# --loop dynavins and whose odometry.tum is --loop off's; and one --loop off run (e_shape stereo) for
+# the estimator's speed without the loop thread.
 # Every run: `dynavins run --rate 0` (lossless replay; at rate 0 the solves are bounded by iterations
 # only), so accuracy does not depend on machine load. A failed run is recorded as failed
 # (manifest + report) and the bench goes on; it exits 1 at the end when a scene or run crashed.
@@ -20,7 +26,8 @@ while [ $# -gt 0 ]; do
   case $1 in
     --quick) quick=1 ;;
     --out) out=$2; shift ;;
-    -h|--help) sed -n '2,12p' "$0"; exit 0 ;;
+    --loop-only) quick=2 ;;
+    -h|--help) sed -n '2,19p' "$0"; exit 0 ;;
     *) echo "bench: unknown argument $1" >&2; exit 2 ;;
   esac
   shift
@@ -31,14 +38,23 @@ tracker_bin=${BENCH_TRACKER:-build/bin/bench_tracker}
 python=${PYTHON:-/usr/bin/python3}
 [ -x "$bin" ] || { echo "bench: $bin not found (make build first)" >&2; exit 1; }
 
+loop_scenes=(temporal_static e_shape revisit)
+bas=(huber dynavins)
 if [ "$quick" = 1 ]; then
   scenarios=(none high)
   sim_args=(--duration 20)
   suffix=-20s
   out=${out:-bench/results/quick}
   extra_seeds=()
+elif [ "$quick" = 2 ]; then
+  scenarios=(e_shape revisit temporal_static)
+  bas=(dynavins)  # the loop table compares loop modes over the DynaVINS odometry
+  sim_args=()
+  suffix=""
+  out=${out:-bench/results/loop}
+  extra_seeds=()
 else
-  scenarios=(none low mid high night mav_none mav_high standstill_none standstill_high dynamic_follow temporal_static e_shape)
+  scenarios=(none low mid high night mav_none mav_high standstill_none standstill_high dynamic_follow temporal_static e_shape revisit)
   sim_args=()
   suffix=""
   out=${out:-bench/results}
@@ -60,7 +76,7 @@ dirty=clean
 cpu=$(grep -m1 'model name' /proc/cpuinfo | cut -d: -f2- | sed 's/^ *//')
 ram_gb=$(awk '/MemTotal/ {printf "%.1f", $2/1048576}' /proc/meminfo)
 {
-  printf 'mode\t%s\n' "$([ "$quick" = 1 ] && echo quick || echo full)"
+  printf 'mode\t%s\n' "$(case $quick in 1) echo quick ;; 2) echo loop ;; *) echo full ;; esac)"
   printf 'commit\t%s\n' "$commit"
   printf 'dirty\t%s\n' "$dirty"
   printf 'date\t%s\n' "$(date -u +%Y-%m-%dT%H:%M:%SZ)"
@@ -68,15 +84,28 @@ ram_gb=$(awk '/MemTotal/ {printf "%.1f", $2/1048576}' /proc/meminfo)
   printf 'cpu\t%s\n' "$cpu"
   printf 'ram_gb\t%s\n' "$ram_gb"
   printf 'binary\t%s\n' "$bin"
-  printf 'bench_command\t%s\n' "scripts/bench.sh$([ "$quick" = 1 ] && echo ' --quick') --out $out"
+  printf 'bench_command\t%s\n' "scripts/bench.sh$(case $quick in 1) echo ' --quick' ;; 2) echo ' --loop-only' ;; esac) --out $out"
   printf 'sim_args\t%s\n' "${sim_args[*]:-}"
 } > "$meta"
 printf 'kind\tscenario\tmode\tba\tvariant\tstatus\twall_s\tdir\tcommand\n' > "$manifest"
 
 # --- progress ---------------------------------------------------------------------------------
-runs_per_scene=4
-total=$(( (${#scenarios[@]} + 2 * ${#extra_seeds[@]}) * (1 + runs_per_scene) + 1 + 1 ))  # scenes x (generate + runs), ablation, overlay
-[ -x "$tracker_bin" ] && total=$((total + 1))
+runs_per_scene=$((2 * ${#bas[@]}))
+loop_sensors=(stereo mono)
+# --loop-only keeps to the runs the loop table needs most: mono (odometry that drifts) on revisit only
+loop_sensors_of() {
+  if [ "$1" = temporal_static ] || { [ "$quick" = 2 ] && [ "$1" != revisit ]; }; then echo stereo; else echo "${loop_sensors[@]}"; fi
+}
+is_loop_scene() { local s; for s in "${loop_scenes[@]}"; do [ "$s" = "$1" ] && return 0; done; return 1; }
+n_loop=0
+for sc in "${scenarios[@]}"; do
+  if is_loop_scene "$sc"; then for m in $(loop_sensors_of "$sc"); do n_loop=$((n_loop + 2)); done; fi
+done
+total=$(( (${#scenarios[@]} + 2 * ${#extra_seeds[@]}) * (1 + runs_per_scene) + n_loop ))  # scenes x (generate + runs), loop modes
+[ "$quick" = 2 ] && total=$(( ${#scenarios[@]} + n_loop / 2 + n_loop ))  # generate, one plain run per sensor, loop modes
+[ "$quick" != 2 ] && for sc in "${scenarios[@]}"; do [ "$sc" = e_shape ] && total=$((total + 1)); done  # --loop off
+[ "$quick" != 2 ] && total=$((total + 2))  # ablation, overlay
+[ -x "$tracker_bin" ] && [ "$quick" != 2 ] && total=$((total + 1))
 step=0
 bench_start=$(date +%s)
 
@@ -129,21 +158,35 @@ scene_runs() {
     echo "bench: generating $scene_cache failed (see $log); its runs are recorded as failed" >&2
     generated=0
   fi
-  for mode in stereo mono; do
-    for ba in huber dynavins; do
+  for mode in $([ "$quick" = 2 ] && loop_sensors_of "$sc" || echo stereo mono); do
+    for ba in "${bas[@]}"; do
       if [ "$generated" = 1 ]; then run_one "$sc" "$mode" "$ba" "$variant"; else not_run "$sc" "$mode" "$ba" "$variant"; fi
     done
   done
   [ "$generated" = 1 ]
 }
 
+loop_speed_scene=e_shape
 for sc in "${scenarios[@]}"; do
   scene_cache=$sc$suffix
   if scene_runs "$sc" "" "${sim_args[@]}"; then
     # Table I: regularisation only (the paper's λm = 0 ablation)
     [ "$sc" = "$ablation_scene" ] && run_one "$sc" stereo dynavins nomomentum --set momentum_on=0
+    # Loop closure (paper IV): the baselines' trajectory.tum beside the plain run's (--loop dynavins)
+    if is_loop_scene "$sc"; then
+      for mode in $(loop_sensors_of "$sc"); do
+        for lm in all switchable; do run_one "$sc" "$mode" dynavins "loop$lm" --loop "$lm"; done
+      done
+      [ "$sc" = "$loop_speed_scene" ] && [ "$quick" != 2 ] && run_one "$sc" stereo dynavins loopoff --loop off
+    fi
   else
     [ "$sc" = "$ablation_scene" ] && not_run "$sc" stereo dynavins nomomentum
+    if is_loop_scene "$sc"; then
+      for mode in $(loop_sensors_of "$sc"); do
+        for lm in all switchable; do not_run "$sc" "$mode" dynavins "loop$lm"; done
+      done
+      [ "$sc" = "$loop_speed_scene" ] && [ "$quick" != 2 ] && not_run "$sc" stereo dynavins loopoff
+    fi
   fi
 done
 
@@ -159,6 +202,7 @@ done
 unset scene_cache
 
 # --- a feature-weight overlay from the DynaVINS stereo run on `high` ---------------------------
+if [ "$quick" != 2 ]; then
 ov=("$bin" overlay --euroc "bench/cache/$overlay_scene$suffix/euroc"
     --features "$out/runs/$overlay_scene/stereo-dynavins/features.csv" --frames 2 --scale 0.6
     --out "$out/overlay_$overlay_scene.png")
@@ -170,6 +214,7 @@ if [ -x "$tracker_bin" ]; then
   timed "bench_tracker" "$out/bench_tracker.txt" "$tracker_bin"
   record bench_tracker - - - - "$status" "$wall" "$out/bench_tracker.txt" "$tracker_bin"
 fi
+fi  # not --loop-only
 
 printf 'bench_wall_s\t%s\n' "$(( $(date +%s) - bench_start ))" >> "$meta"
 

@@ -37,8 +37,12 @@ LoopStage::~LoopStage() = default;
 void LoopStage::account(const loop::LoopCloserOutput& out, double ms) {
   ms_sum_ += ms;
   ms_max_ = std::max(ms_max_, ms);
+  descriptors_ms_sum_ += out.timing.descriptors_ms;
+  query_ms_sum_ += out.timing.query_ms;
+  verification_ms_sum_ += out.timing.verification_ms;
   if (out.optimized) {
     opt_ms_max_ = std::max(opt_ms_max_, out.timing.optimization_ms);
+    opt_ms_sum_ += out.timing.optimization_ms;
     spdlog::debug("loop: optimised at t = {} ns ({:.1f} ms)", out.t_ns, out.timing.optimization_ms);
   }
   if (on_output) on_output(out);
@@ -48,7 +52,9 @@ void LoopStage::process(Keyframe keyframe) {
   const auto t0 = std::chrono::steady_clock::now();
   const loop::LoopCloserOutput out = closer_->add_keyframe(keyframe);
   ++keyframes_;
-  account(out, std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count());
+  const double ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+  keyframe_ms_.push_back(ms);
+  account(out, ms);
 }
 
 void LoopStage::finish() {
@@ -70,6 +76,17 @@ LoopRunSummary LoopStage::summary() const {
   s.optimizations = closer_->num_optimizations();
   s.keyframe_ms_mean = keyframes_ > 0 ? ms_sum_ / static_cast<double>(keyframes_) : 0.0;
   s.keyframe_ms_max = ms_max_;
+  if (!keyframe_ms_.empty()) {
+    std::vector<double> sorted = keyframe_ms_;
+    const auto k = static_cast<std::size_t>(0.95 * static_cast<double>(sorted.size() - 1) + 0.5);
+    std::nth_element(sorted.begin(), sorted.begin() + static_cast<std::ptrdiff_t>(k), sorted.end());
+    s.keyframe_ms_p95 = sorted[k];
+    const auto n = static_cast<double>(keyframe_ms_.size());
+    s.descriptors_ms_mean = descriptors_ms_sum_ / n;
+    s.query_ms_mean = query_ms_sum_ / n;
+    s.verification_ms_mean = verification_ms_sum_ / n;
+  }
+  if (closer_->num_optimizations() > 0) s.optimization_ms_mean = opt_ms_sum_ / closer_->num_optimizations();
   s.optimization_ms_max = opt_ms_max_;
   s.memory_bytes = closer_->memory_bytes();
   s.corrections = closer_->keyframe_corrections();

@@ -35,8 +35,12 @@ struct LoopRunSummary {
   int64_t keyframes_dropped = 0;  ///< real time only: the keyframe queue was full (the chain skips them)
   int64_t groups = 0, optimizations = 0;
   double keyframe_ms_mean = 0, keyframe_ms_max = 0;  ///< process() per keyframe, optimisation included
+  double keyframe_ms_p95 = 0;                        ///< 95th percentile of the same
+  /// Means per keyframe of its parts: ORB descriptors, bag of words + database query, PnP verification of
+  /// the candidates; and the pose-graph optimisation's mean over the optimisations that ran.
+  double descriptors_ms_mean = 0, query_ms_mean = 0, verification_ms_mean = 0, optimization_ms_mean = 0;
   double optimization_ms_max = 0;
-  std::size_t memory_bytes = 0;  ///< the keyframe database, no images
+  std::size_t memory_bytes = 0;                       ///< the keyframe database, no images
   std::vector<loop::KeyframeCorrection> corrections;  ///< per keyframe, after the final optimisation
   std::vector<VerifiedLoop> loops;                    ///< every verified loop, in detection order
   std::vector<loop::LoopReportRow> rows;              ///< per loop: group, hypothesis, final weight, used
@@ -70,6 +74,8 @@ class LoopStage {
   std::unique_ptr<loop::LoopCloser> closer_;
   int64_t keyframes_ = 0;
   double ms_sum_ = 0, ms_max_ = 0, opt_ms_max_ = 0;
+  std::vector<double> keyframe_ms_;  // per keyframe (8 bytes each), for the p95
+  double descriptors_ms_sum_ = 0, query_ms_sum_ = 0, verification_ms_sum_ = 0, opt_ms_sum_ = 0;
 };
 
 }  // namespace dynavins::pipeline

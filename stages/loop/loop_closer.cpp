@@ -95,6 +95,9 @@ LoopCloserOutput LoopCloser::process(KeyframeDescriptors d, double descriptors_m
   t0 = Clock::now();
   for (const PlaceCandidate& c : candidates) {
     const LoopVerification v = verifier_.verify(d, entries_[static_cast<std::size_t>(c.keyframe_id)]);
+    spdlog::debug("loop candidate: query {} match {} score {:.3f} matches {} inliers {} -> {}", d.t_ns,
+                  entries_[static_cast<std::size_t>(c.keyframe_id)].t_ns, c.score, v.matches, v.inliers,
+                  v.accepted ? "verified" : to_string(v.rejection));
     if (!v.accepted) continue;
     const std::size_t index = optimizer_.loops().size();
     if (!optimizer_.add_loop(v.loop)) continue;
