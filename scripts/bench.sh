@@ -38,7 +38,8 @@ if [ "$quick" = 1 ]; then
   out=${out:-bench/results/quick}
   extra_seeds=()
 else
-  scenarios=(none low mid high night mav_none mav_high standstill_none standstill_high dynamic_follow temporal_static e_shape)
+  scenarios=(none low mid high night mav_none mav_high standstill_none standstill_high dynamic_follow temporal_static e_shape
+             street_none street_crowd street_follow_none street_follow)
   sim_args=()
   suffix=""
   out=${out:-bench/results}
