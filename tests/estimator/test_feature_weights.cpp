@@ -72,6 +72,7 @@ TEST_CASE("state step: a kept feature at full weight, a rejected one relative to
           "[feature_weights]") {
   FeatureWeightParams p;  // λw = 1: a one-sigma track (r = 1) has weight 0.5
   p.lambda_m = 0.0;
+  p.kept_full_weight = true;
   // Static tracks at ordinary noise (RMS error below one sigma) enter the state solve at full weight,
   // as under Huber, though their eq. (10) weights are 0.5-1.
   for (double r : {0.0, 0.3, 0.7, 1.0}) CHECK(stateStepWeight(solveFeatureWeight(r, 1.0, 0, p), p) == Approx(1.0));
@@ -97,6 +98,7 @@ TEST_CASE("r_j is per residual component: a track at exactly the configured nois
           "[feature_weights]") {
   FeatureWeightParams p;
   p.lambda_m = 0.0;
+  p.residual_per_component = true;
   // Whitened 2-D residuals with unit variance per component (the noise model): E[|e|^2] = 2.
   std::mt19937 rng(3);
   std::normal_distribution<double> unit(0.0, 1.0);
