@@ -114,9 +114,7 @@ def best_static_residual(R_cw, p_wc, xy):
                 break
         else:
             lam *= 10
-    # mean squared whitened residual per component (2 per observation), as the estimator's r_j
-    # (feature_weights.hpp, residual_per_component)
-    return cost / (2 * len(xy))
+    return cost / len(xy)  # mean squared norm of the 2-D whitened residual, as r_j
 
 
 def camera_file(config_yaml, cam=0):
