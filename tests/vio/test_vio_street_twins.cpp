@@ -5,6 +5,9 @@
 // Huber's (the goal, no cost at all, is not reached yet: README, "Street scenes"); in the crowd,
 // the moving features rejected, an ATE close to its own static twin's and far below Huber's. The bounds
 // are ratios between runs of the same binary with margins for the noise of one draw, not measured values.
+// Measured when written (Release): static twin dynavins 0.045 m, huber 0.028 m, 4.3 % of 1571 static
+// features rejected; crowd dynavins 0.033 m, no reset, 97.2 % of 654 moving features rejected, huber
+// 8.5 m with 4 resets.
 #include "tests/estimator/catch_with_ceres.hpp"
 
 #include "eval/evaluation.hpp"
