@@ -55,6 +55,8 @@ const std::vector<OptionSpec>& optionSpecs() {
       {"alternating_converge", &O::alternating_converge, {0, 1, true}, "", "share of settled weights that ends the alternation"},
       {"margin_feature_thresh", &O::margin_feature_thresh, {0, 1}, "", "features under this weight stay out of the prior"},
       {"weighted_huber", &O::weighted_huber, {}, "", "Huber loss under the weights (ours); 0 = the paper's eq. 4"},
+      {"kept_full_weight", &O::kept_full_weight, {}, "", "1: kept features at full weight in the state step (ours, issue 23; off: mixed result, README); 0 = w_j^2 (eq. 11)"},
+      {"residual_per_component", &O::residual_per_component, {}, "", "1: r_j per residual component, in units of the configured noise (ours, issue 23; off: mixed result, README); 0 = per observation"},
       {"zupt", &O::zupt, {}, "", "zero-velocity update (ours, OpenVINS' keys)"},
       {"zupt_max_velocity", &O::zupt_max_velocity, {0, 10}, "m/s", "at rest only below this speed of the last solve"},
       {"zupt_max_disparity", &O::zupt_max_disparity, {0, 50}, "px", "at rest only below this median rotation-compensated motion"},

@@ -81,6 +81,17 @@ struct EstimatorOptions {
   /// (dynavins mode). A weight judges a whole track; the Huber loss still bounds one bad observation of a
   /// kept track (a one-frame KLT slip). 0 gives the paper's eq. 4 exactly (weights replace the Huber loss).
   bool weighted_huber = true;
+  /// Ours, not the paper's: the state step of the alternation gives a kept feature (eq. 10 weight at or
+  /// above the weight of a one-sigma track, 0.5 at lambda_w = 1) its full weight, as Huber does, and a
+  /// rejected one its weight relative to that (feature_weights.hpp, stateStepWeight). 0 (default) = the
+  /// paper's w_j^2 on every feature; off by default: it helped the fast street twins and hurt `none`
+  /// (README, "Street scenes").
+  bool kept_full_weight = false;
+  /// Ours: r_j of the weight step is the mean squared whitened residual per residual component (2 per
+  /// observation), so r_j = 1 is a track at exactly the configured noise (feature_weights.hpp). 0
+  /// (default) = per observation (a track at the configured noise then has r_j ~ 2 and is rejected);
+  /// off by default for the same measured reason as kept_full_weight.
+  bool residual_per_component = false;
   /// Ours, not the paper's: zero-velocity update (standstill_detector.hpp), with OpenVINS' key names and
   /// defaults. A frame whose kept features show less than `zupt_max_disparity` px of rotation-compensated
   /// motion while the last solve's speed is under `zupt_max_velocity` m/s has its velocity held at zero.

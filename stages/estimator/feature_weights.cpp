@@ -18,6 +18,13 @@ double solveFeatureWeight(double r, double w_prev, int n, const FeatureWeightPar
   return std::clamp(w, 0.0, 1.0);
 }
 
+double stateStepWeight(double w, const FeatureWeightParams& p) {
+  if (!p.kept_full_weight) return w;
+  const double w_consistent = p.lambda_w / (p.lambda_w + 1.0);  // eq. (7) at r_j = 1 (RMS error one σ)
+  if (!(w_consistent > 0)) return w;                            // λw = 0: every weight is 0 anyway
+  return std::min(1.0, w / w_consistent);
+}
+
 double featureWeightCost(double w, double r, double w_prev, int n, const FeatureWeightParams& p) {
   const double m = momentumGain(n, p);
   return w * w * r + p.lambda_w * (1 - w) * (1 - w) + m * (w_prev - w) * (w_prev - w);
@@ -28,6 +35,12 @@ double meanSquaredResidual(const std::vector<double>& squared_norms) {
   double s = 0;
   for (double v : squared_norms) s += v;
   return s / static_cast<double>(squared_norms.size());
+}
+
+double featureResidualScale(const std::vector<double>& squared_norms, const FeatureWeightParams& p) {
+  constexpr double kComponentsPerObservation = 2.0;  // a reprojection residual is 2-D
+  const double per_observation = meanSquaredResidual(squared_norms);
+  return p.residual_per_component ? per_observation / kComponentsPerObservation : per_observation;
 }
 
 }  // namespace dynavins::estimator

@@ -40,6 +40,8 @@ WindowSolveOptions solveOptions(const EstimatorOptions& o, const EstimatorMode& 
   s.zero_velocity_sigma = o.zero_velocity_sigma;
   s.margin_feature_thresh = o.margin_feature_thresh;
   s.weighted_huber = o.weighted_huber;
+  s.weights.kept_full_weight = o.kept_full_weight;
+  s.weights.residual_per_component = o.residual_per_component;
   return s;
 }
 

@@ -35,7 +35,8 @@ struct WindowFeature {
   std::vector<FeatureObservation> obs;  ///< obs[k] is at slot start_slot + k
   double inv_depth = 0;                 ///< 1 / z in the anchor's cam0; the BA's parameter block
   bool has_depth = false;
-  double weight = 1.0;       ///< w_j (paper eq. 10), the value the reprojection factors read
+  double weight = 1.0;       ///< w_j (paper eq. 10), the weight the run reports and scores
+  double state_weight = 1.0;  ///< ŵ_j = stateStepWeight(w_j), the value the reprojection factors read
   double weight_prev = 1.0;  ///< w̄_j: weight after the previous window solve
   int times_solved = 0;      ///< n_j
   int8_t sim_label = -1;     ///< simulator label at the latest observation (scoring only)

@@ -38,7 +38,7 @@ struct VisualResidual {
 std::vector<VisualResidual> visualResiduals(WindowState& s, WindowFeature& f, const WindowSolveOptions& o) {
   std::vector<VisualResidual> out;
   const bool dyn = o.loss == BaLoss::Dynavins;
-  const double* w = dyn ? &f.weight : nullptr;
+  const double* w = dyn ? &f.state_weight : nullptr;  // ŵ_j (feature_weights.hpp)
   const int i = f.start_slot;
   const Eigen::Vector2d& xy_i = f.obs[0].xy;
   double* pose_i = s.pose[i].data();
@@ -119,12 +119,12 @@ struct FeatureGeometry {
     if (p_c.z() <= 1e-3) return Eigen::Vector2d(1e2, 1e2);  // behind the camera: as bad as it gets
     return sqrt_info * (p_c.head<2>() / p_c.z() - o.xy);
   }
-  /// Mean squared whitened residual of the weighted observations (r_j of feature_weights.hpp).
-  double weightedMean(double rho) const {
+  /// r_j of feature_weights.hpp over the weighted observations (featureResidualScale).
+  double weightedMean(double rho, const FeatureWeightParams& p) const {
     std::vector<double> sq;
     for (const Obs& o : obs)
       if (o.weighted) sq.push_back(residual(o, rho).squaredNorm());
-    return meanSquaredResidual(sq);
+    return featureResidualScale(sq, p);
   }
   /// Inverse depth that best explains every observation with the poses fixed (1-D Gauss-Newton).
   double bestInverseDepth(double rho) const {
@@ -166,7 +166,7 @@ double featureResidualWith(const WindowFeature& f, const WindowSolveOptions& opt
     if (k > 0) g.obs.push_back({camera(j, 0), f.obs[k].xy, true});
     if (opt.stereo && f.obs[k].has_right) g.obs.push_back({camera(j, 1), f.obs[k].xy_right, k > 0});
   }
-  return g.weightedMean(g.bestInverseDepth(f.inv_depth));
+  return g.weightedMean(g.bestInverseDepth(f.inv_depth), opt.weights);
 }
 
 }  // namespace
@@ -319,6 +319,7 @@ class WeightStep {
       const double w = solveFeatureWeight(r, f->weight_prev, f->times_solved, opt_.weights);
       if (std::abs(w - f->weight) < opt_.settle_tolerance) ++settled;
       f->weight = w;
+      f->state_weight = stateStepWeight(w, opt_.weights);
     }
     st_.weight_ms += msSince(t0);
     return features.empty() ? 1.0 : static_cast<double>(settled) / features.size();

@@ -67,3 +67,51 @@ TEST_CASE("mean squared residual is the per-observation mean", "[feature_weights
   CHECK(meanSquaredResidual({}) == 0.0);
   CHECK(meanSquaredResidual({1.0, 2.0, 6.0}) == Approx(3.0));
 }
+
+TEST_CASE("state step: a kept feature at full weight, a rejected one relative to a one-sigma track",
+          "[feature_weights]") {
+  FeatureWeightParams p;  // λw = 1: a one-sigma track (r = 1) has weight 0.5
+  p.lambda_m = 0.0;
+  p.kept_full_weight = true;
+  // Static tracks at ordinary noise (RMS error below one sigma) enter the state solve at full weight,
+  // as under Huber, though their eq. (10) weights are 0.5-1.
+  for (double r : {0.0, 0.3, 0.7, 1.0}) CHECK(stateStepWeight(solveFeatureWeight(r, 1.0, 0, p), p) == Approx(1.0));
+  // Beyond one sigma the state weight falls with r, and the weighted cost ŵ² r of a far outlier vanishes.
+  double previous = 1.0;
+  for (double r : {1.5, 3.0, 10.0, 100.0, 1e4}) {
+    const double w_hat = stateStepWeight(solveFeatureWeight(r, 1.0, 0, p), p);
+    CHECK(w_hat < previous);
+    CHECK(w_hat == Approx(2.0 / (1.0 + r)));  // w / 0.5
+    previous = w_hat;
+  }
+  CHECK(stateStepWeight(solveFeatureWeight(1e4, 1.0, 0, p), p) * stateStepWeight(solveFeatureWeight(1e4, 1.0, 0, p), p) * 1e4 < 1e-3);
+  // Other λw: the line is still the weight of a one-sigma track.
+  p.lambda_w = 4.0;  // γ = 2
+  CHECK(stateStepWeight(solveFeatureWeight(1.0, 1.0, 0, p), p) == Approx(1.0));
+  CHECK(stateStepWeight(solveFeatureWeight(3.0, 1.0, 0, p), p) == Approx((4.0 / 7.0) / 0.8));
+  // Switched off, the state step uses w_j itself (the paper's eq. 11).
+  p.kept_full_weight = false;
+  CHECK(stateStepWeight(0.3, p) == 0.3);
+}
+
+TEST_CASE("r_j is per residual component: a track at exactly the configured noise has r_j ~ 1, weight ~ 0.5",
+          "[feature_weights]") {
+  FeatureWeightParams p;
+  p.lambda_m = 0.0;
+  p.residual_per_component = true;
+  // Whitened 2-D residuals with unit variance per component (the noise model): E[|e|^2] = 2.
+  std::mt19937 rng(3);
+  std::normal_distribution<double> unit(0.0, 1.0);
+  std::vector<double> sq;
+  for (int k = 0; k < 20000; ++k) {
+    const double ex = unit(rng), ey = unit(rng);
+    sq.push_back(ex * ex + ey * ey);
+  }
+  const double r = featureResidualScale(sq, p);
+  CHECK(r == Approx(1.0).margin(0.03));
+  CHECK(solveFeatureWeight(r, 1.0, 0, p) == Approx(0.5).margin(0.01));
+  // Per observation, the same consistent track would have r ~ 2 and be rejected (weight ~ 1/3).
+  p.residual_per_component = false;
+  CHECK(featureResidualScale(sq, p) == Approx(2.0).margin(0.06));
+  CHECK(solveFeatureWeight(featureResidualScale(sq, p), 1.0, 0, p) < 0.4);
+}

@@ -1,0 +1,89 @@
+// A crowded street and its static twin (tests/data/scenarios/street_crowd_short.yaml and
+// street_static_short.yaml: the same world, noise seed and 12 s path at 3 m/s; issue 23), through the
+// shipped chain (runVioSequential, rate 0: iteration-bound, so the same answer on any machine).
+// What it checks: where nothing moves, few static features rejected and dynavins' ATE within a bound of
+// Huber's (the issue's goal, no cost at all, is not reached yet: README, "Street scenes"); in the crowd,
+// the moving features rejected, an ATE close to its own static twin's and far below Huber's. The bounds
+// are ratios between runs of the same binary with margins for the noise of one draw, not measured values.
+// Measured when written (Release): static twin dynavins 0.045 m, huber 0.028 m, 4.3 % of 1571 static
+// features rejected; crowd dynavins 0.033 m, no reset, 97.2 % of 654 moving features rejected, huber
+// 8.5 m with 4 resets.
+#include "tests/estimator/catch_with_ceres.hpp"
+
+#include "eval/evaluation.hpp"
+#include "pipeline/vio/estimate_recorder.hpp"
+#include "pipeline/vio/vio_pipeline.hpp"
+#include "sim/scenario/scenario_config.hpp"
+#include "sim/scenario/scenario_spec.hpp"
+
+using namespace dynavins;
+
+namespace {
+
+// Issue 23's goals, with a margin where one 12 s noise draw moves the ratio (see the file comment).
+// The static twin's bound is NOT the issue's goal (1.0x huber): the defaults cost 1.36x on the long
+// street_none and 1.59x here when written (0.045 vs 0.028 m; README, "Street scenes"); this bound only
+// catches a larger regression.
+constexpr double kStillMargin = 2.0;         // static twin: dynavins ATE <= this x huber's
+constexpr double kMaxStaticRejected = 0.05;  // static twin: share of static features with weight < 0.5
+constexpr double kMinMovingRejected = 0.85;  // crowd: share of moving features with weight < 0.5
+constexpr double kDegradationBound = 1.5;    // crowd / static twin, dynavins (goal 1.2)
+constexpr double kHuberRatio = 0.2;          // crowd: dynavins ATE <= this x huber's unless huber reset
+
+struct Outcome {
+  pipeline::EstimateRecorder run;
+  double ate = 1e9;
+};
+
+Outcome runScene(const std::shared_ptr<const sim::Scenario>& sc, estimator::BaLoss loss) {
+  sim::ScenarioSource src(sc);
+  pipeline::VioRunOptions opt;
+  opt.estimator = sim::scenarioEstimatorOptions(*sc);
+  opt.mode.loss = loss;
+  opt.show_progress = false;
+  Outcome o;
+  pipeline::VioSinks sinks;
+  sinks.estimate = [&o](const estimator::WindowEstimate& e) { o.run.record(e); };
+  const pipeline::VioRunResult r = pipeline::runVioSequential(src, opt, sinks);
+  REQUIRE(r.report.ok);
+  o.ate = eval::evaluate(pipeline::groundTruthTrajectory(r.ground_truth), o.run.estimate).ate.rmse;
+  return o;
+}
+
+std::shared_ptr<const sim::Scenario> scene(const std::string& name) {
+  return sim::build_scenario(
+      sim::load_scenario(std::string(DYNAVINS_SOURCE_DIR) + "/tests/data/scenarios/" + name + ".yaml"));
+}
+
+}  // namespace
+
+TEST_CASE("street twins: the robust BA keeps the static street and holds in the crowd",
+          "[vio][dynamic][street]") {
+  const auto still = scene("street_static_short");
+  const Outcome dyn_still = runScene(still, estimator::BaLoss::Dynavins);
+  const Outcome hub_still = runScene(still, estimator::BaLoss::Huber);
+  INFO("static twin: dynavins ATE " << dyn_still.ate << " m, huber " << hub_still.ate << " m");
+  REQUIRE(dyn_still.run.resets == 0);
+  REQUIRE(hub_still.run.resets == 0);
+  CHECK(dyn_still.run.tracking_frames >= 0.9 * dyn_still.run.frames);
+  // No cost when nothing moves: within Huber's ATE (with the margin of one noise draw).
+  CHECK(dyn_still.ate <= kStillMargin * hub_still.ate);
+  const eval::WeightScore still_score = eval::scoreWeights(dyn_still.run.features);
+  REQUIRE(still_score.static_ > 100);
+  CHECK(still_score.moving == 0);
+  CHECK(1.0 - still_score.static_kept < kMaxStaticRejected);
+
+  const auto crowd = scene("street_crowd_short");
+  const Outcome dyn_crowd = runScene(crowd, estimator::BaLoss::Dynavins);
+  const Outcome hub_crowd = runScene(crowd, estimator::BaLoss::Huber);
+  INFO("crowd: dynavins ATE " << dyn_crowd.ate << " m (resets " << dyn_crowd.run.resets << "), huber "
+                              << hub_crowd.ate << " m (resets " << hub_crowd.run.resets << ")");
+  CHECK(dyn_crowd.run.resets == 0);
+  CHECK(dyn_crowd.run.tracking_frames >= 0.9 * dyn_crowd.run.frames);
+  const eval::WeightScore crowd_score = eval::scoreWeights(dyn_crowd.run.features);
+  REQUIRE(crowd_score.moving > 50);  // the vehicles were seen and went through the BA
+  CHECK(crowd_score.moving_rejected >= kMinMovingRejected);
+  // Degradation against its own static twin, and far below the baseline.
+  CHECK(dyn_crowd.ate <= kDegradationBound * dyn_still.ate);
+  CHECK((hub_crowd.run.resets > 0 || dyn_crowd.ate <= kHuberRatio * hub_crowd.ate));
+}
