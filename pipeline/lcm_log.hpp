@@ -12,6 +12,8 @@
 #include <string>
 #include <vector>
 
+#include "pipeline/wire_decode.hpp"
+
 namespace lcm {
 class LogFile;
 }
@@ -67,13 +69,10 @@ class LcmLogReader {
   bool next(LogRecord& out);
 
   /// Decodes a record as `Msg`; throws naming the file, event and channel if it is not one.
+  /// Length fields are checked before anything is allocated (pipeline/wire_decode.hpp).
   template <typename Msg>
   Msg decode(const LogRecord& r) const {
-    Msg m;
-    const int n = m.decode(r.data.data(), 0, static_cast<int>(r.data.size()));
-    if (n != static_cast<int>(r.data.size()))
-      throw std::runtime_error(where(r) + ": payload is not a valid " + Msg::getTypeName());
-    return m;
+    return decode_payload<Msg>(r.data, where(r));
   }
 
   /// "event #N (byte B, channel C)" for error messages.
