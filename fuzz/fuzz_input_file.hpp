@@ -8,7 +8,7 @@
 
 namespace dynavins::fuzz {
 
-/// A folder of this process for fuzz inputs (created on first use).
+/// A folder of this process for fuzz inputs (created on first use, when logging is also switched off).
 const std::string& fuzz_scratch_dir();
 
 /// Writes `size` bytes at `data` to fuzz_scratch_dir()/`name` and returns that path.

@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# Runs each libFuzzer harness of fuzz/ for FUZZ_SECONDS (default 600) on one core (-jobs=1: the
+# Runs each libFuzzer harness of fuzz/ for FUZZ_SECONDS (default 600) on one core (a single fuzzing process, no -jobs or -fork: the
 # machine is shared), one after the other, from a seed corpus made of real inputs (make_fuzz_seeds).
 #   scripts/fuzz.sh <fuzz build dir> [harness ...]     (default: every harness)
 # Per harness, in <build>/fuzz-runs/<name>/: corpus/ (seeds + what libFuzzer adds), crash-* files,
@@ -19,7 +19,7 @@ SEEDS=$RUNS/seeds
 
 mkdir -p "$RUNS"
 rm -rf "$SEEDS"
-"$BUILD/fuzz/make_fuzz_seeds" "$SHARED" "$SEEDS" || exit 1
+"$BUILD/bin/make_fuzz_seeds" "$SHARED" "$SEEDS" || exit 1
 
 # Per-input memory: a reader may hold a few decoded images; 1 GB RSS is far beyond any valid input here.
 export ASAN_OPTIONS="detect_leaks=1:allocator_may_return_null=0:${ASAN_OPTIONS:-}"
@@ -35,7 +35,7 @@ for h in "${HARNESSES[@]}"; do
   echo "fuzz: $h for ${SECONDS_EACH}s"
   start=$(date +%s)
   # max_len: the seeds (a few frames shrunk to 24x16) stay below 16 kB; larger inputs add no new paths.
-  "$BUILD/fuzz/fuzz_$h" "$dir/corpus" -max_total_time="$SECONDS_EACH" -jobs=1 -workers=1 -max_len=16384 \
+  "$BUILD/bin/fuzz_$h" "$dir/corpus" -max_total_time="$SECONDS_EACH" -max_len=16384 \
     -rss_limit_mb=1024 -malloc_limit_mb=1024 -timeout=25 -print_final_stats=1 \
     -artifact_prefix="$dir/artifacts/" >"$dir/log.txt" 2>&1
   rc=$?
