@@ -18,6 +18,11 @@
 
 #include <opencv2/imgproc.hpp>
 
+#include <dynavins_lcm/loop_hypotheses_t.hpp>
+#include <dynavins_lcm/path_t.hpp>
+#include <dynavins_lcm/pipeline_stats_t.hpp>
+#include <dynavins_lcm/status_t.hpp>
+
 #include "io/euroc_dataset.hpp"
 #include "pipeline/lcm_channels.hpp"
 #include "pipeline/lcm_convert.hpp"
@@ -91,7 +96,7 @@ void write_logs(const Clip& c, const fs::path& dir) {
       pipeline::write_sensor_event(log, f, encoding);
     }
     // A channel the source skips and counts.
-    log.write(pipeline::channels::kImu + std::string("_OTHER"), 1, pipeline::to_lcm(c.imu.front()));
+    log.write(channels::kImu + std::string("_OTHER"), 1, pipeline::to_lcm(c.imu.front()));
     log.close();
   }
 }

@@ -44,7 +44,10 @@ ConfigReader::ConfigReader(const std::string& path) : path_(path) {
   if (!fs_.isOpened()) throw ConfigError(path, "", "cannot open as an OpenCV yaml file");
   // OpenCV's map keeps every entry while fs_[key] finds the first, so a repeat is seen here.
   const cv::FileNode root = fs_.root();
-  if (!root.isMap()) return;
+  // A sequence or a scalar at the top (found by fuzz_camera): OpenCV asserts on any key lookup in it.
+  if (root.isSeq() || root.isString() || root.isInt() || root.isReal())
+    throw ConfigError(path, "", "the top level is " + type_name(root) + ", not a map of keys");
+  if (!root.isMap()) return;  // empty: every key is missing
   std::set<std::string> seen;
   for (auto it = root.begin(); it != root.end(); ++it) {
     const std::string key = (*it).name();
@@ -57,7 +60,9 @@ void ConfigReader::fail(const std::string& key, const std::string& problem) cons
   throw ConfigError(path_, key, problem);
 }
 
-cv::FileNode ConfigReader::node(const std::string& key) const { return fs_[key]; }
+cv::FileNode ConfigReader::node(const std::string& key) const {
+  return fs_.root().isMap() ? fs_[key] : cv::FileNode();  // OpenCV asserts on a lookup in a non-map
+}
 
 bool ConfigReader::has(const std::string& key) const {
   const cv::FileNode n = node(key);

@@ -234,6 +234,11 @@ TEST_CASE("Errors name the key and the file", "[options][errors]") {
     CHECK_THROWS_AS(ConfigReader(cam), ConfigError);
     CHECK_THROWS_WITH(ConfigReader(cam), Catch::Contains(cam) && Catch::Contains("not a valid OpenCV yaml file"));
   }
+  SECTION("a yaml whose top level is a sequence names the file (OpenCV asserted in its key lookup)") {
+    const std::string path = (s.dir / "sequence.yaml").string();
+    std::ofstream(path) << "%YAML:1.0\n- 1\n- 2\n";
+    CHECK_THROWS_WITH(EstimatorOptions::load(path), Catch::Contains(path) && Catch::Contains("not a map of keys"));
+  }
   SECTION("missing camera calibration file") {
     const std::string path = s.edit(base, "cam1_mei.yaml", "cam1_missing.yaml");
     CHECK_THROWS_WITH(EstimatorOptions::load(path), Catch::Contains(path) && Catch::Contains("'cam1_calib'") &&
