@@ -3,10 +3,13 @@
 
 BUILD      ?= build
 TSAN_BUILD ?= build-tsan
+ASAN_BUILD ?= build-asan
+FUZZ_BUILD ?= build-fuzz
+FUZZ_SECONDS ?= 600
 CMAKE_GEN  := -G Ninja
 CTEST_J    ?= 2
 
-.PHONY: all deps build demo bench bench-quick test test-unit test-tsan lint format-check vocab vocab-check clean
+.PHONY: all deps build demo bench bench-quick test test-unit test-tsan test-asan fuzz lint format-check vocab vocab-check clean
 
 all: build
 
@@ -56,6 +59,28 @@ test-tsan: deps
 	TSAN_OPTIONS="halt_on_error=1 second_deadlock_stack=1 suppressions=$(CURDIR)/tests/tsan.supp" \
 	  ctest --test-dir $(TSAN_BUILD) --output-on-failure -j $(CTEST_J) -LE heavy
 
+# The whole suite under AddressSanitizer + UndefinedBehaviorSanitizer (separate build tree; -O1 -g1), but
+# for the tests labelled heavy. Leaks are checked (LeakSanitizer, on by default with ASan on Linux); any
+# undefined behaviour aborts the test (-fno-sanitize-recover). Suppressions: third-party code only, each
+# with its reason, in tests/lsan.supp. Not part of `make test` (see README: its time).
+test-asan: deps
+	cmake -S . -B $(ASAN_BUILD) $(CMAKE_GEN) -DCMAKE_BUILD_TYPE=Release -DDYNAVINS_ASAN=ON -DDYNAVINS_HEAVY_TESTS=OFF -DDYNAVINS_BUILD_BENCH=OFF
+	cmake --build $(ASAN_BUILD)
+	ASAN_OPTIONS="detect_leaks=1 halt_on_error=1 strict_string_checks=1 detect_stack_use_after_return=0" \
+	  LSAN_OPTIONS="suppressions=$(CURDIR)/tests/lsan.supp print_suppressions=0" \
+	  UBSAN_OPTIONS="print_stacktrace=1 halt_on_error=1" \
+	  ctest --test-dir $(ASAN_BUILD) --output-on-failure -j $(CTEST_J) -LE heavy
+
+# libFuzzer (Debian's clang) on the input readers: the LCM log reader, the wire-type decoders, the EuRoC
+# CSV reader, the yaml config and camera loaders, the rosbag import (fuzz/). Each harness runs
+# FUZZ_SECONDS (default 600) on one core, one after the other, from seeds made of the real inputs in
+# ../shared; results in $(FUZZ_BUILD)/fuzz-runs/summary.md (scripts/fuzz.sh). Fails if a crash is found.
+fuzz: deps
+	cmake -S . -B $(FUZZ_BUILD) $(CMAKE_GEN) -DCMAKE_BUILD_TYPE=Release -DCMAKE_C_COMPILER=clang -DCMAKE_CXX_COMPILER=clang++ \
+	  -DDYNAVINS_FUZZ=ON -DDYNAVINS_BUILD_TESTS=OFF -DDYNAVINS_BUILD_BENCH=OFF -DDYNAVINS_BUILD_CLI=OFF
+	cmake --build $(FUZZ_BUILD) --target fuzzers
+	FUZZ_SECONDS=$(FUZZ_SECONDS) ./scripts/fuzz.sh $(FUZZ_BUILD)
+
 # Naming convention (CONTRIBUTING.md): clang-tidy with only readability-identifier-naming (.clang-tidy) over
 # the project's own sources in $(BUILD)/compile_commands.json (generated code under $(BUILD)/ and
 # third_party/ left out); fails on any violation. Not yet enforced in CI: the tree still has violations.
@@ -83,4 +108,4 @@ vocab-check: build
 	  rc=$$?; rm -f $$tmp; exit $$rc
 
 clean:
-	rm -rf $(BUILD) $(TSAN_BUILD)
+	rm -rf $(BUILD) $(TSAN_BUILD) $(ASAN_BUILD) $(FUZZ_BUILD)

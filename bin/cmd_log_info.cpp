@@ -1,5 +1,7 @@
 // `dynavins log-info FILE.lcmlog`: what a recorded log holds, per channel: events, type, rate, span.
-// Reads the whole log, so a truncated or corrupt log is reported (file, event, byte) with exit 2.
+// Reads the whole log, so a truncated or corrupt log is reported (file, event, byte) with exit 2: a bad
+// event header, a payload of a dynavins_lcm type that does not decode, or a checksum block that does
+// not match its events (logs written by dynavins carry them, pipeline/lcm_log.hpp).
 #include <cstdio>
 #include <map>
 #include <string>
@@ -30,9 +32,17 @@ struct ChannelSummary {
   int64_t fingerprint = 0;
 };
 
+/// A known type: its name and a check that a payload decodes as one (lengths, exact size).
+struct KnownType {
+  std::string name;
+  void (*check)(const pipeline::LcmLogReader& reader, const pipeline::LogRecord& r);
+};
+
 template <typename... Msg>
-std::map<int64_t, std::string> known_types() {
-  return {{Msg::getHash(), Msg::getTypeName()}...};
+std::map<int64_t, KnownType> known_types() {
+  return {{Msg::getHash(),
+           KnownType{Msg::getTypeName(),
+                     [](const pipeline::LcmLogReader& reader, const pipeline::LogRecord& r) { (void)reader.decode<Msg>(r); }}}...};
 }
 
 void run_log_info(const std::string& path) {
@@ -42,17 +52,21 @@ void run_log_info(const std::string& path) {
                                  dynavins_lcm::pipeline_stats_t>();
   std::map<std::string, ChannelSummary> channels;
   int64_t total = 0;
+  pipeline::LogChecksumStats checksums;
   try {
     pipeline::LcmLogReader reader(path);
     pipeline::LogRecord r;
     while (reader.next(r)) {
       auto& c = channels[r.channel];
       if (c.events == 0) c.first_utime = r.utime, c.fingerprint = pipeline::payload_fingerprint(r.data);
+      // Every payload of a known type must decode (a corrupt length is an error naming the event).
+      if (const auto t = types.find(pipeline::payload_fingerprint(r.data)); t != types.end()) t->second.check(reader, r);
       ++c.events;
       c.bytes += static_cast<int64_t>(r.data.size());
       c.last_utime = r.utime;
       ++total;
     }
+    checksums = reader.checksum_stats();
   } catch (const std::runtime_error& e) {
     throw CommandError(e.what(), 2);
   }
@@ -63,8 +77,15 @@ void run_log_info(const std::string& path) {
     const auto t = types.find(c.fingerprint);
     std::printf("%-20s %9lld %12.3f %9.2f %10.3f  %s\n", name.c_str(), static_cast<long long>(c.events),
                 static_cast<double>(c.bytes) / 1e6, span > 0 ? static_cast<double>(c.events - 1) / span : 0.0, span,
-                t == types.end() ? "(not a dynavins_lcm type)" : t->second.c_str());
+                t == types.end() ? "(not a dynavins_lcm type)" : t->second.name.c_str());
   }
+  if (checksums.blocks_verified == 0 && checksums.foreign_checksums == 0)
+    std::printf("checksums: none (not written by dynavins, e.g. lcm-logger): payloads not verified\n");
+  else
+    std::printf("checksums: %lld blocks verified (%lld events); %lld events after the last one; %lld checksums of "
+                "another log (not checked)\n",
+                static_cast<long long>(checksums.blocks_verified), static_cast<long long>(checksums.events_verified),
+                static_cast<long long>(checksums.events_unverified), static_cast<long long>(checksums.foreign_checksums));
 }
 
 }  // namespace

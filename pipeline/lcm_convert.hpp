@@ -4,6 +4,8 @@
 // std::runtime_error naming the field.
 
 #include <cstdint>
+#include <stdexcept>
+#include <string>
 
 #include <dynavins_lcm/ground_truth_t.hpp>
 #include <dynavins_lcm/image_t.hpp>
@@ -24,7 +26,13 @@ namespace dynavins::pipeline {
 struct RunReport;
 
 inline int64_t ns_to_utime(int64_t ns) { return ns >= 0 ? (ns + 500) / 1000 : -((-ns + 500) / 1000); }
-inline int64_t utime_to_ns(int64_t utime) { return utime * 1000; }
+/// Throws std::runtime_error for a utime beyond +-292 years, whose nanoseconds overflow int64 (corrupt
+/// wire data; found by fuzz_lcm_decode and fuzz_lcm_log).
+inline int64_t utime_to_ns(int64_t utime) {
+  if (utime > INT64_MAX / 1000 || utime < INT64_MIN / 1000)
+    throw std::runtime_error("utime " + std::to_string(utime) + " us is out of range");
+  return utime * 1000;
+}
 
 enum class ImageEncoding : int8_t { Gray8 = 0, Png = 1 };
 

@@ -14,6 +14,7 @@
 #include "pipeline/interrupt.hpp"
 #include "pipeline/lcm_channels.hpp"
 #include "pipeline/lcm_convert.hpp"
+#include "pipeline/wire_decode.hpp"
 
 namespace dynavins::pipeline {
 namespace {
@@ -24,14 +25,8 @@ constexpr int kPollMs = 20;
 /// type's (rather than a truncated or corrupt payload).
 template <typename Msg>
 bool decode(const lcm::ReceiveBuffer* rbuf, Msg& msg, bool& wrong_type) {
-  int64_t hash = 0;
-  if (rbuf->data_size >= 8) {
-    const auto* b = static_cast<const uint8_t*>(rbuf->data);
-    for (int i = 0; i < 8; ++i) hash = (hash << 8) | b[i];
-  }
-  wrong_type = rbuf->data_size >= 8 && hash != Msg::getHash();
-  if (wrong_type) return false;
-  return msg.decode(rbuf->data, 0, static_cast<int>(rbuf->data_size)) == static_cast<int>(rbuf->data_size);
+  std::string problem;
+  return try_decode_payload(static_cast<const uint8_t*>(rbuf->data), rbuf->data_size, msg, problem, wrong_type);
 }
 
 }  // namespace

@@ -24,6 +24,8 @@ PACKAGES=(
   librosbag-storage-dev libsensor-msgs-dev libnav-msgs-dev
   # naming and format checks (make lint, make format-check)
   clang-tidy clang-format
+  # libFuzzer and the sanitizer runtimes for clang (make fuzz)
+  clang libclang-rt-14-dev
   # benchmark report and figures (bench/report/make_report.py, run with /usr/bin/python3)
   python3 python3-matplotlib python3-numpy
 )

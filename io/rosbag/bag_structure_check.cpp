@@ -173,6 +173,7 @@ class ChunkData {
     if (off > size_ || n > size_ - off)
       f_.fail(pos_,
               fmt::format("{} at chunk offset {} ({} bytes) runs past the chunk ({} bytes)", what, off, n, size_));
+    if (n == 0) return;  // an empty header's vector has no buffer: memcpy from/to null is undefined even for 0 bytes
     if (in_memory_)
       std::memcpy(dst, mem_.data() + off, n);
     else

@@ -35,11 +35,19 @@ ConfigReader::ConfigReader(const std::string& path) : path_(path) {
   } catch (const cv::Exception& e) {
     // e.err is OpenCV's own short description (e.msg adds its source file and function).
     throw ConfigError(path, "", "not a valid OpenCV yaml file (" + e.err + "); a VINS-Fusion config starts with %YAML:1.0");
+  } catch (const std::exception& e) {
+    // OpenCV's parser also lets standard exceptions out on some malformed files (found by fuzz_camera:
+    // std::length_error from basic_string); they are the same bad file.
+    throw ConfigError(path, "", std::string("not a valid OpenCV yaml file (its parser failed: ") + e.what() +
+                                    "); a VINS-Fusion config starts with %YAML:1.0");
   }
   if (!fs_.isOpened()) throw ConfigError(path, "", "cannot open as an OpenCV yaml file");
   // OpenCV's map keeps every entry while fs_[key] finds the first, so a repeat is seen here.
   const cv::FileNode root = fs_.root();
-  if (!root.isMap()) return;
+  // A sequence or a scalar at the top (found by fuzz_camera): OpenCV asserts on any key lookup in it.
+  if (root.isSeq() || root.isString() || root.isInt() || root.isReal())
+    throw ConfigError(path, "", "the top level is " + type_name(root) + ", not a map of keys");
+  if (!root.isMap()) return;  // empty: every key is missing
   std::set<std::string> seen;
   for (auto it = root.begin(); it != root.end(); ++it) {
     const std::string key = (*it).name();
@@ -52,7 +60,9 @@ void ConfigReader::fail(const std::string& key, const std::string& problem) cons
   throw ConfigError(path_, key, problem);
 }
 
-cv::FileNode ConfigReader::node(const std::string& key) const { return fs_[key]; }
+cv::FileNode ConfigReader::node(const std::string& key) const {
+  return fs_.root().isMap() ? fs_[key] : cv::FileNode();  // OpenCV asserts on a lookup in a non-map
+}
 
 bool ConfigReader::has(const std::string& key) const {
   const cv::FileNode n = node(key);
@@ -134,6 +144,14 @@ Eigen::Isometry3d ConfigReader::get_transform(const std::string& key) const {
   if (!has(key)) fail(key, "required key is missing");
   const cv::FileNode n = node(key);
   if (!n.isMap()) fail(key, "expected a 4x4 !!opencv-matrix, found " + type_name(n));
+  // rows, cols and the data's length checked before OpenCV reads the matrix: it allocates rows x cols
+  // as written (a garbled `rows` made it ask for 64 GB, found by fuzz_config).
+  for (const char* dim : {"rows", "cols"})
+    if (!n[dim].isInt() || static_cast<int>(n[dim]) != 4)
+      fail(key, std::string("expected a 4x4 !!opencv-matrix, found ") + dim + ": " +
+                    (n[dim].isInt() ? std::to_string(static_cast<int>(n[dim])) : type_name(n[dim])));
+  if (!n["data"].isSeq() || n["data"].size() != 16)
+    fail(key, "expected a 4x4 !!opencv-matrix: data must be a sequence of 16 numbers");
   cv::Mat m;
   try {
     n >> m;

@@ -103,6 +103,7 @@ struct SlidingWindowEstimator::Impl {
   bool tracking = false;
   bool gravity_aligned = false;
   std::string last_init_failure;  ///< last reason initialisation failed, logged when it changes
+  std::string last_fail_reason;   ///< reason of the last failed frame (a reset or a frame dropped before tracking)
   // Per slot, moved with the slot (slide): the tracked frame's seq and left image (shallow), for keyframes.
   std::vector<int64_t> slot_seq;
   std::vector<cv::Mat> slot_image;
@@ -382,13 +383,19 @@ WindowEstimate SlidingWindowEstimator::Impl::process(const TrackedFrame& frame, 
   };
   // `latest_slot`: the slot of the latest frame before this one when the failure came before the solve
   // (slots below it are keyframes with the last Tracking poses: handed out), -1 after the solve (dropped).
+  // One event per failure: "reset: <why>" when tracking is lost (status Reset, what the run counts as a
+  // reset). Before tracking (just after a reset, e.g. on every frame of a long IMU outage) nothing is lost
+  // but this frame: "not initialised: <why>", once until the reason changes.
   auto fail = [&](const std::string& why, int latest_slot) -> WindowEstimate {
-    spdlog::warn("estimator reset at t={:.3f} s: {}", frame.t_ns * 1e-9, why);
     const bool was_tracking = tracking;
+    const bool repeat = !was_tracking && why == last_fail_reason;
+    last_fail_reason = why;
+    if (was_tracking) spdlog::warn("estimator reset at t={:.3f} s: {}", frame.t_ns * 1e-9, why);
+    else if (!repeat) spdlog::info("frame at t={:.3f} s not estimated (not initialised): {}", frame.t_ns * 1e-9, why);
     if (was_tracking && latest_slot > 0) emitKeyframes(latest_slot, e.finished_keyframes);
     resetAll();
     e.status = was_tracking ? EstimatorStatus::Reset : EstimatorStatus::Initializing;
-    e.event = "reset: " + why;
+    e.event = was_tracking ? "reset: " + why : repeat ? std::string() : "not initialised: " + why;
     return finish(e);
   };
 
@@ -407,6 +414,7 @@ WindowEstimate SlidingWindowEstimator::Impl::process(const TrackedFrame& frame, 
     std::string why;
     if (!predictNewest(*imu, &why)) return fail(why, newest - 1);
   }
+  last_fail_reason.clear();  // this frame is in: the next failure is a new event
   const Eigen::Vector3d last_p = newest > 0 ? Eigen::Vector3d(state.p(newest - 1)) : Eigen::Vector3d::Zero();
   const Eigen::Quaterniond last_q = newest > 0 ? state.q(newest - 1) : Eigen::Quaterniond::Identity();
   const bool keep_second_newest =

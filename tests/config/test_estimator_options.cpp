@@ -22,6 +22,7 @@
 
 #include "io/vins_config_writer.hpp"
 #include "stages/common/config_error.hpp"
+#include "stages/common/config_reader.hpp"
 #include "stages/common/estimator_options.hpp"
 #include "tests/log_capture.hpp"
 
@@ -220,6 +221,23 @@ TEST_CASE("Errors name the key and the file", "[options][errors]") {
   SECTION("extrinsic that is not a matrix") {
     const std::string path = s.edit(base, "body_T_cam1: !!opencv-matrix", "body_T_cam1: 3\nunused: !!opencv-matrix");
     CHECK_THROWS_WITH(EstimatorOptions::load(path), Catch::Contains(path) && Catch::Contains("'body_T_cam1'"));
+  }
+  SECTION("an extrinsic matrix of the wrong size is rejected by its header, before OpenCV allocates it") {
+    // Found by fuzz_config: a garbled `rows` made OpenCV ask for a 64 GB matrix.
+    const std::string path = s.edit(base, "body_T_cam1: !!opencv-matrix\n   rows: 4", "body_T_cam1: !!opencv-matrix\n   rows: 400000");
+    CHECK_THROWS_WITH(EstimatorOptions::load(path),
+                      Catch::Contains(path) && Catch::Contains("'body_T_cam1'") && Catch::Contains("rows: 400000"));
+  }
+  SECTION("an OpenCV parser failure that is not a cv::Exception is a ConfigError naming the file") {
+    // Found by fuzz_camera (tests/data/fuzz_regressions/camera/): std::length_error out of FileStorage::open.
+    const std::string cam = (fs::path(DYNAVINS_SOURCE_DIR) / "tests/data/fuzz_regressions/camera/opencv_parser_length_error.yaml").string();
+    CHECK_THROWS_AS(ConfigReader(cam), ConfigError);
+    CHECK_THROWS_WITH(ConfigReader(cam), Catch::Contains(cam) && Catch::Contains("not a valid OpenCV yaml file"));
+  }
+  SECTION("a yaml whose top level is a sequence names the file (OpenCV asserted in its key lookup)") {
+    const std::string path = (s.dir / "sequence.yaml").string();
+    std::ofstream(path) << "%YAML:1.0\n- 1\n- 2\n";
+    CHECK_THROWS_WITH(EstimatorOptions::load(path), Catch::Contains(path) && Catch::Contains("not a map of keys"));
   }
   SECTION("missing camera calibration file") {
     const std::string path = s.edit(base, "cam1_mei.yaml", "cam1_missing.yaml");
