@@ -4,7 +4,7 @@
 // bound of the simulator's ground truth, while the Huber baseline (VINS-Fusion's loss) does not.
 // Measured when written: dynavins ATE 0.12 m, no reset, 98.9% of truck features rejected;
 // huber ATE 6.5 m with 2 resets.
-#include "tests/estimator/catch_with_ceres.hpp"
+#include "tests/vio/scene_run.hpp"
 
 #include "eval/evaluation.hpp"
 #include "pipeline/vio/estimate_recorder.hpp"
@@ -17,26 +17,10 @@ using namespace dynavins;
 namespace {
 constexpr double kAteBound = 0.3;  // metres over a 12 s, ~35 m flight
 
-struct Outcome {
-  pipeline::EstimateRecorder run;
-  std::map<int64_t, double> true_speed;
-  double ate = 1e9;
-};
+using Outcome = test::SceneRun;
 
 Outcome runScene(const std::shared_ptr<const sim::Scenario>& sc, estimator::BaLoss loss) {
-  sim::ScenarioSource src(sc);
-  pipeline::VioRunOptions opt;
-  opt.estimator = sim::scenarioEstimatorOptions(*sc);
-  opt.mode.loss = loss;
-  opt.show_progress = false;
-  Outcome o;
-  pipeline::VioSinks sinks;
-  sinks.estimate = [&o](const estimator::WindowEstimate& e) { o.run.record(e); };
-  const pipeline::VioRunResult r = pipeline::runVioSequential(src, opt, sinks);
-  REQUIRE(r.report.ok);
-  o.true_speed = pipeline::groundTruthSpeed(r.ground_truth);
-  o.ate = eval::evaluate(pipeline::groundTruthTrajectory(r.ground_truth), o.run.estimate).ate.rmse;
-  return o;
+  return test::run_scene(sc, loss);
 }
 }  // namespace
 

@@ -8,7 +8,7 @@
 // Measured when written (Release): static twin dynavins 0.045 m, huber 0.028 m, 4.3 % of 1571 static
 // features rejected; crowd dynavins 0.033 m, no reset, 97.2 % of 654 moving features rejected, huber
 // 8.5 m with 4 resets.
-#include "tests/estimator/catch_with_ceres.hpp"
+#include "tests/vio/scene_run.hpp"
 
 #include "eval/evaluation.hpp"
 #include "pipeline/vio/estimate_recorder.hpp"
@@ -30,24 +30,10 @@ constexpr double kMinMovingRejected = 0.85;  // crowd: share of moving features 
 constexpr double kDegradationBound = 1.5;    // crowd / static twin, dynavins (goal 1.2)
 constexpr double kHuberRatio = 0.2;          // crowd: dynavins ATE <= this x huber's unless huber reset
 
-struct Outcome {
-  pipeline::EstimateRecorder run;
-  double ate = 1e9;
-};
+using Outcome = test::SceneRun;
 
 Outcome runScene(const std::shared_ptr<const sim::Scenario>& sc, estimator::BaLoss loss) {
-  sim::ScenarioSource src(sc);
-  pipeline::VioRunOptions opt;
-  opt.estimator = sim::scenarioEstimatorOptions(*sc);
-  opt.mode.loss = loss;
-  opt.show_progress = false;
-  Outcome o;
-  pipeline::VioSinks sinks;
-  sinks.estimate = [&o](const estimator::WindowEstimate& e) { o.run.record(e); };
-  const pipeline::VioRunResult r = pipeline::runVioSequential(src, opt, sinks);
-  REQUIRE(r.report.ok);
-  o.ate = eval::evaluate(pipeline::groundTruthTrajectory(r.ground_truth), o.run.estimate).ate.rmse;
-  return o;
+  return test::run_scene(sc, loss);
 }
 
 std::shared_ptr<const sim::Scenario> scene(const std::string& name) {

@@ -1,0 +1,39 @@
+#pragma once
+// One simulated scene through the shipped chain (runVioSequential, rate 0: iteration-bound, so the same
+// answer on any machine), scored against the simulator's ground truth. Shared by the scene tests.
+#include <cstdint>
+#include <map>
+#include <memory>
+
+#include "tests/estimator/catch_with_ceres.hpp"
+
+#include "eval/evaluation.hpp"
+#include "pipeline/vio/estimate_recorder.hpp"
+#include "pipeline/vio/vio_pipeline.hpp"
+#include "sim/scenario/scenario_config.hpp"
+
+namespace dynavins::test {
+
+struct SceneRun {
+  pipeline::EstimateRecorder run;          ///< every estimate of the run
+  std::map<int64_t, double> true_speed;    ///< ground-truth speed [m/s] by time [ns]
+  double ate = 1e9;                        ///< ATE RMSE [m] (SE3) against the ground truth
+};
+
+inline SceneRun run_scene(const std::shared_ptr<const sim::Scenario>& sc, estimator::BaLoss loss) {
+  sim::ScenarioSource src(sc);
+  pipeline::VioRunOptions opt;
+  opt.estimator = sim::scenarioEstimatorOptions(*sc);
+  opt.mode.loss = loss;
+  opt.show_progress = false;
+  SceneRun o;
+  pipeline::VioSinks sinks;
+  sinks.estimate = [&o](const estimator::WindowEstimate& e) { o.run.record(e); };
+  const pipeline::VioRunResult r = pipeline::runVioSequential(src, opt, sinks);
+  REQUIRE(r.report.ok);
+  o.true_speed = pipeline::groundTruthSpeed(r.ground_truth);
+  o.ate = eval::evaluate(pipeline::groundTruthTrajectory(r.ground_truth), o.run.estimate).ate.rmse;
+  return o;
+}
+
+}  // namespace dynavins::test
