@@ -1,5 +1,5 @@
 // bench_estimator: one scenario, huber and dynavins side by side through the shipped chain run on one
-// thread (runVioSequential: the stages of `dynavins run`, deterministic): ATE, feature scoring, BA ms, and
+// thread (run_vio_sequential: the stages of `dynavins run`, deterministic): ATE, feature scoring, BA ms, and
 // how far each static track strays from its true point.
 //   bench_estimator --scenario high [--duration S] [--mono] [--ba huber,dynavins]
 #include <filesystem>
@@ -57,7 +57,7 @@ class TrackTruth {
     }
   }
   /// Largest error of the track so far [px at 460], or -1 when unknown.
-  double maxError(int64_t id) const {
+  double max_error(int64_t id) const {
     auto it = max_err_.find(id);
     return it == max_err_.end() ? -1 : it->second;
   }
@@ -90,13 +90,13 @@ int main(int argc, char** argv) {
   const auto sc = sim::build_scenario(sim::load_scenario(path), std::nullopt, duration);
   // Rate 0: iteration-bound solves (max_num_iterations only), so the answer does not depend on machine load.
   pipeline::VioRunOptions opt;
-  opt.estimator = sim::scenarioEstimatorOptions(*sc);
+  opt.estimator = sim::scenario_estimator_options(*sc);
   opt.show_progress = false;
 
   std::stringstream ss(modes);
   std::string m;
   while (std::getline(ss, m, ',')) {
-    opt.mode.loss = estimator::parseBaLoss(m);
+    opt.mode.loss = estimator::parse_ba_loss(m);
     opt.mode.stereo = !mono;
     sim::ScenarioSource src(sc);
     TrackTruth truth(src, *sc);
@@ -105,12 +105,12 @@ int main(int argc, char** argv) {
     sinks.estimate = [&r](const estimator::WindowEstimate& e) { r.record(e); };
     // Sequential: the tracker sees each frame while the source's last rendered frame (its depth) is it.
     sinks.tracked = [&truth](const TrackedFrame& f) { truth(f); };
-    const pipeline::VioRunResult run = pipeline::runVioSequential(src, opt, sinks);
+    const pipeline::VioRunResult run = pipeline::run_vio_sequential(src, opt, sinks);
     if (!run.report.ok) {
       spdlog::error("{}: {} failed: {}", m, run.report.failed_thread, run.report.error);
       return 1;
     }
-    const eval::Trajectory ground_truth = pipeline::groundTruthTrajectory(run.ground_truth);
+    const eval::Trajectory ground_truth = pipeline::ground_truth_trajectory(run.ground_truth);
     if (!out_dir.empty()) {
       std::filesystem::create_directories(out_dir);
       eval::write_tum(out_dir + "/" + m + ".tum", r.estimate);
@@ -128,11 +128,11 @@ int main(int argc, char** argv) {
     for (double v : ba) mean += v;
     mean = ba.empty() ? 0 : mean / ba.size();
     const double p95 = ba.empty() ? 0 : ba[static_cast<size_t>(0.95 * (ba.size() - 1))];
-    const auto sw = eval::scoreWeights(r.features);
+    const auto sw = eval::score_weights(r.features);
     std::printf("%-9s %s %s: ATE %.4f m | frames %d tracking %d resets %d | BA ms mean %.2f p95 %.2f | "
                 "moving %d rejected %.1f%% | static %d kept %.1f%%\n",
                 m.c_str(), scenario.c_str(), mono ? "mono" : "stereo", ate, r.frames, r.tracking_frames, r.resets,
-                mean, p95, sw.moving, 100 * sw.moving_rejected, sw.static_, 100 * sw.static_kept);
+                mean, p95, sw.moving, 100 * sw.moving_rejected, sw.stationary, 100 * sw.static_kept);
     int low_by_n[4] = {0, 0, 0, 0};  // static features ending under 0.5, by solves: 1, 2-3, 4-9, 10+
     for (const auto& [id, f] : r.features) {
       if (f.sim_label != 0 || f.weight >= 0.5f || f.times_solved == 0) continue;
@@ -141,7 +141,7 @@ int main(int argc, char** argv) {
     int kept_good = 0, good = 0, drifted = 0, drifted_low = 0;  // static tracks true to 2 px, and the rest
     for (const auto& [id, f] : r.features) {
       if (f.sim_label != 0 || f.times_solved == 0) continue;
-      const double e = truth.maxError(id);
+      const double e = truth.max_error(id);
       if (e < 0) continue;
       if (e <= 2.0) {
         ++good;
@@ -153,8 +153,8 @@ int main(int argc, char** argv) {
     }
     std::vector<double> e_low, e_high;
     for (const auto& [id, f] : r.features) {
-      if (f.sim_label != 0 || f.times_solved == 0 || truth.maxError(id) < 0) continue;
-      (f.weight < 0.5f ? e_low : e_high).push_back(truth.maxError(id));
+      if (f.sim_label != 0 || f.times_solved == 0 || truth.max_error(id) < 0) continue;
+      (f.weight < 0.5f ? e_low : e_high).push_back(truth.max_error(id));
     }
     auto q = [](std::vector<double> v, double p) {
       if (v.empty()) return -1.0;

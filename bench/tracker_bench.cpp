@@ -72,10 +72,10 @@ void time_ms(Times* t, F&& f) {
 /// without our first-patch refinement (plain VINS-Fusion KLT), to show what it costs.
 struct Variant {
   const char* name;
-  TrackerOptions options;
+  tracker::TrackerOptions options;
 };
 std::vector<Variant> variants() {
-  TrackerOptions base, ransac, clahe, plain;
+  tracker::TrackerOptions base, ransac, clahe, plain;
   ransac.f_ransac = true;
   clahe.clahe = true;
   plain.patch_refine = false;
@@ -99,7 +99,7 @@ void run_variants(const Args& args, const char* data, const std::vector<StereoFr
   for (int r = 0; r < args.repeat; ++r)
     for (const Variant& v : variants()) {
       if (!selected(args, v)) continue;
-      StereoTracker tracker(v.options, c0, c1);
+      tracker::StereoTracker tracker(v.options, c0, c1);
       Times ms;
       std::vector<TrackedFrame> out;
       for (const auto& f : frames) time_ms(&ms, [&] { out.push_back(tracker.process(f)); });
@@ -172,8 +172,8 @@ int main(int argc, char** argv) {
   if (args.euroc) {
     const std::string dir = std::string(DYNAVINS_SHARED_DIR) + "/data/euroc_v1_01_micro";
     const io::EurocDataset data(dir);
-    const auto c0 = load_kalibr_camera(dir + "/mav0/cam0/sensor.yaml");
-    const auto c1 = load_kalibr_camera(dir + "/mav0/cam1/sensor.yaml");
+    const auto c0 = tracker::load_kalibr_camera(dir + "/mav0/cam0/sensor.yaml");
+    const auto c1 = tracker::load_kalibr_camera(dir + "/mav0/cam1/sensor.yaml");
     std::vector<StereoFrame> frames;
     for (std::size_t i = 0; i < data.frames().size(); ++i) frames.push_back(data.load(i));
     run_variants(args, "euroc", frames, c0.camera, c1.camera);

@@ -42,7 +42,7 @@ struct DecodeOptions {
 struct ChannelCount {
   int64_t messages = 0;
   int64_t first_utime = 0, last_utime = 0;  ///< the messages' own (sensor) times
-  double rateHz() const {
+  double rate_hz() const {
     return messages > 1 && last_utime > first_utime ? (messages - 1) / ((last_utime - first_utime) * 1e-6) : 0.0;
   }
   void add(int64_t utime) {
@@ -59,7 +59,7 @@ struct Findings {
   }
 };
 
-bool finitePose(const dynavins_lcm::pose_t& m) {
+bool finite_pose(const dynavins_lcm::pose_t& m) {
   double qn = 0;
   for (double x : m.orientation) qn += x * x;
   for (double x : m.position)
@@ -69,10 +69,10 @@ bool finitePose(const dynavins_lcm::pose_t& m) {
 
 eval::StampedPose stamped(const dynavins_lcm::pose_t& m) {
   const Eigen::Quaterniond q(m.orientation[0], m.orientation[1], m.orientation[2], m.orientation[3]);
-  return eval::stampedPose(m.utime * 1000, Eigen::Vector3d(m.position[0], m.position[1], m.position[2]), q);
+  return eval::stamped_pose(m.utime * 1000, Eigen::Vector3d(m.position[0], m.position[1], m.position[2]), q);
 }
 
-void runDecode(const DecodeOptions& o) {
+void run_decode(const DecodeOptions& o) {
   pipeline::PublisherChannels ch;
   try {
     for (const std::string& c : o.channels) ch.set(c);
@@ -102,13 +102,13 @@ void runDecode(const DecodeOptions& o) {
         if (r.channel == ch.pose || r.channel == ch.pose_imu || r.channel == ch.pose_corrected) {
           const auto m = reader->decode<dynavins_lcm::pose_t>(r);
           counts[r.channel].add(m.utime);
-          if (!finitePose(m)) f.fail(reader->where(r) + ": pose is not finite or its quaternion is not unit");
+          if (!finite_pose(m)) f.fail(reader->where(r) + ": pose is not finite or its quaternion is not unit");
           (r.channel == ch.pose ? window : r.channel == ch.pose_imu ? imu_rate : corrected).poses.push_back(stamped(m));
         } else if (r.channel == ch.path) {
           const auto m = reader->decode<dynavins_lcm::path_t>(r);
           counts[r.channel].add(m.utime);
           for (const auto& p : m.poses)
-            if (!finitePose(p)) f.fail(reader->where(r) + ": a path pose is not finite");
+            if (!finite_pose(p)) f.fail(reader->where(r) + ": a path pose is not finite");
         } else if (r.channel == ch.loops) {
           const auto m = reader->decode<dynavins_lcm::loop_hypotheses_t>(r);
           counts[r.channel].add(m.utime);
@@ -150,7 +150,7 @@ void runDecode(const DecodeOptions& o) {
   for (const auto& [key, name] : ch.list()) {
     const ChannelCount c = counts.count(name) ? counts[name] : ChannelCount{};
     std::printf("%-24s %-10s %10lld %10.1f\n", name.c_str(), key.c_str(), static_cast<long long>(c.messages),
-                c.rateHz());
+                c.rate_hz());
   }
   std::printf("features                %lld in all, weights in [%.3f, %.3f], %.1f %% below 0.5\n",
               static_cast<long long>(features), features ? w_min : 0.f, features ? w_max : 0.f,
@@ -183,7 +183,7 @@ void add_decode_command(CLI::App& app) {
   cmd->add_option("--log", o->log, "LCM log recorded with lcm-logger")->required();
   cmd->add_option("--out", o->out, "Write pose.tum, pose_imu.tum and status.csv here");
   cmd->add_option("--channel", o->channels, "Output channel name as given to run/live: --channel key=NAME");
-  cmd->callback([o] { runDecode(*o); });
+  cmd->callback([o] { run_decode(*o); });
 }
 
 }  // namespace dynavins::cli

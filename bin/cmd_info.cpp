@@ -39,15 +39,15 @@ void run_info() {
               LCM_MINOR_VERSION, LCM_MICRO_VERSION, SPDLOG_VER_MAJOR, SPDLOG_VER_MINOR, SPDLOG_VER_PATCH,
               CLI11_VERSION);
   std::printf("LCM wire types (package dynavins_lcm) and their channels:\n");
-  print_type<dynavins_lcm::stereo_image_t>(channels::kStereo);
-  print_type<dynavins_lcm::imu_t>(channels::kImu);
-  print_type<dynavins_lcm::ground_truth_t>(channels::kGroundTruth);
-  print_type<dynavins_lcm::image_t>(channels::kSimLabels);
+  print_type<dynavins_lcm::stereo_image_t>(pipeline::channels::kStereo);
+  print_type<dynavins_lcm::imu_t>(pipeline::channels::kImu);
+  print_type<dynavins_lcm::ground_truth_t>(pipeline::channels::kGroundTruth);
+  print_type<dynavins_lcm::image_t>(pipeline::channels::kSimLabels);
   print_type<dynavins_lcm::pose_t>("DYNAVINS_POSE, DYNAVINS_POSE_IMU");
-  print_type<dynavins_lcm::weighted_feature_set_t>(channels::kFeatures);
-  print_type<dynavins_lcm::loop_hypotheses_t>(channels::kLoops);
-  print_type<dynavins_lcm::path_t>(channels::kPath);
-  print_type<dynavins_lcm::pipeline_stats_t>(channels::kStats);
+  print_type<dynavins_lcm::weighted_feature_set_t>(pipeline::channels::kFeatures);
+  print_type<dynavins_lcm::loop_hypotheses_t>(pipeline::channels::kLoops);
+  print_type<dynavins_lcm::path_t>(pipeline::channels::kPath);
+  print_type<dynavins_lcm::pipeline_stats_t>(pipeline::channels::kStats);
   std::printf("lcm-spy: CLASSPATH=build/share/java/dynavins_lcm_types.jar lcm-spy\n");
 }
 
@@ -59,7 +59,7 @@ void add_info_command(CLI::App& app) {
   cmd->add_flag("--options-markdown", *markdown, "Print the config keys (yaml and --set) as a Markdown table");
   cmd->callback([markdown] {
     if (*markdown)
-      std::fputs(optionsMarkdownTable().c_str(), stdout);
+      std::fputs(options_markdown_table().c_str(), stdout);
     else
       run_info();
   });

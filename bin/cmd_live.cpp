@@ -53,7 +53,7 @@ void live(const LiveCommandOptions& o) {
   pipeline::RunDescription what;
   what.config_path = vio.config;
   what.input = "live:" + input_url;
-  what.ba_loss = estimator::toString(opt.mode.loss);
+  what.ba_loss = estimator::to_string(opt.mode.loss);
   what.stereo = opt.mode.stereo;
   const std::string out_dir = vio.out.empty() ? "runs/live-" + what.ba_loss : vio.out;
 

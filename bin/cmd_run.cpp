@@ -25,14 +25,14 @@ struct RunCommandOptions {
   double rate = 0.0;
 };
 
-std::string inputName(const SensorInput& in) {
+std::string input_name(const SensorInput& in) {
   const std::string p = !in.euroc.empty() ? in.euroc : !in.rosbag.empty() ? in.rosbag : in.log;
   fs::path path(p);
   if (path.filename().empty()) path = path.parent_path();  // "dir/" -> "dir"
   return path.stem().string();
 }
 
-std::string inputLabel(const SensorInput& in) {
+std::string input_label(const SensorInput& in) {
   if (!in.euroc.empty()) return "euroc:" + in.euroc;
   if (!in.rosbag.empty()) return "rosbag:" + in.rosbag;
   return "log:" + in.log;
@@ -45,11 +45,11 @@ void run(const RunCommandOptions& o) {
 
   pipeline::RunDescription what;
   what.config_path = o.vio.config;
-  what.input = inputLabel(o.input);
-  what.ba_loss = estimator::toString(opt.mode.loss);
+  what.input = input_label(o.input);
+  what.ba_loss = estimator::to_string(opt.mode.loss);
   what.stereo = opt.mode.stereo;
   what.rate = o.rate;
-  const std::string out_dir = o.vio.out.empty() ? "runs/" + inputName(o.input) + "-" + what.ba_loss : o.vio.out;
+  const std::string out_dir = o.vio.out.empty() ? "runs/" + input_name(o.input) + "-" + what.ba_loss : o.vio.out;
   spdlog::info("run: {} BA, {}, rate {}, gyro-predicted KLT {} -> {}", what.ba_loss, what.stereo ? "stereo" : "mono",
                o.rate > 0 ? fmt::format("{}x real time", o.rate) : std::string("as fast as possible"),
                opt.gyro_prediction ? "on" : "off", out_dir);

@@ -50,9 +50,9 @@ pipeline::VioRunOptions VioCommandOptions::load(double rate) const {
   pipeline::VioRunOptions opt;
   try {
     std::vector<std::pair<std::string, std::string>> overrides;
-    for (const std::string& s : set) overrides.push_back(EstimatorOptions::parseOverride(s));
+    for (const std::string& s : set) overrides.push_back(EstimatorOptions::parse_override(s));
     opt.estimator = EstimatorOptions::load(config, overrides);
-    opt.mode.loss = estimator::parseBaLoss(ba);
+    opt.mode.loss = estimator::parse_ba_loss(ba);
     opt.mode.stereo = !mono;
     opt.rate = rate;
     opt.imu_rate_hz = imu_rate_hz;
@@ -66,7 +66,7 @@ pipeline::VioRunOptions VioCommandOptions::load(double rate) const {
       if (!std::filesystem::is_regular_file(opt.vocabulary))
         throw std::invalid_argument("--vocabulary " + opt.vocabulary + ": no such file (or --loop off)");
     }
-    pipeline::checkVioOptions(opt);
+    pipeline::check_vio_options(opt);
   } catch (const std::exception& e) {
     throw CommandError(e.what(), 2);
   }
@@ -124,9 +124,9 @@ void print_summary(const pipeline::VioRunResult& r, const pipeline::RunOutputs& 
   if (outputs.ate().evaluated)
     std::printf("ATE         %.4f m (SE3), %.4f m (Sim3) over %zu poses (odometry)\n", outputs.ate().se3_m,
                 outputs.ate().sim3_m, outputs.ate().matched);
-  if (r.loop && outputs.trajectoryAte().evaluated)
+  if (r.loop && outputs.trajectory_ate().evaluated)
     std::printf("ATE         %.4f m (SE3), %.4f m (Sim3) after loop closure (trajectory.tum)\n",
-                outputs.trajectoryAte().se3_m, outputs.trajectoryAte().sim3_m);
+                outputs.trajectory_ate().se3_m, outputs.trajectory_ate().sim3_m);
   else if (!outputs.ate().error.empty())
     std::printf("ATE         not computed: %s\n", outputs.ate().error.c_str());
   std::printf("outputs     %s\n", out_dir.c_str());
@@ -147,7 +147,7 @@ void run_vio_with_outputs(io::SensorSource& source, const pipeline::VioRunOption
   sinks.estimate = [&](const estimator::WindowEstimate& e) { outputs->write(e); };
   pipeline::VioRunResult r;
   try {
-    r = pipeline::runVio(source, opt, sinks);
+    r = pipeline::run_vio(source, opt, sinks);
   } catch (const std::exception& e) {  // options that cannot run, an LCM URL that does not open
     throw CommandError(e.what(), 2);
   }

@@ -117,10 +117,10 @@ void markers(cv::Mat& img, const View& v, const std::vector<Eigen::Vector3d>& pa
 
 cv::Scalar comparison_color(std::size_t i) {
   // Tableau-like colours in BGR: orange, blue, green, red, purple, brown, pink, olive.
-  static const std::array<cv::Scalar, 8> palette = {
+  static const std::array<cv::Scalar, 8> kPalette = {
       cv::Scalar(14, 127, 255), cv::Scalar(180, 119, 31), cv::Scalar(44, 160, 44),   cv::Scalar(40, 39, 214),
       cv::Scalar(189, 103, 148), cv::Scalar(75, 86, 140), cv::Scalar(194, 119, 227), cv::Scalar(34, 189, 188)};
-  return palette[i % palette.size()];
+  return kPalette[i % kPalette.size()];
 }
 
 cv::Mat render_comparison_plot(const std::vector<Eigen::Vector3d>& gt, const std::vector<NamedPath>& estimates,

@@ -20,7 +20,7 @@ struct StampedPose {
 };
 
 /// The pose at `t_ns` (both time forms filled, `q` normalised).
-inline StampedPose stampedPose(std::int64_t t_ns, const Eigen::Vector3d& p, const Eigen::Quaterniond& q) {
+inline StampedPose stamped_pose(std::int64_t t_ns, const Eigen::Vector3d& p, const Eigen::Quaterniond& q) {
   StampedPose s;
   s.t_ns = t_ns;
   s.t = static_cast<double>(t_ns) * 1e-9;

@@ -2,7 +2,7 @@
 
 namespace dynavins::eval {
 
-WeightScore scoreWeights(const std::map<int64_t, FeatureOutcome>& features) {
+WeightScore score_weights(const std::map<int64_t, FeatureOutcome>& features) {
   WeightScore s;
   int moving_low = 0, static_high = 0;
   for (const auto& [id, f] : features) {
@@ -11,12 +11,12 @@ WeightScore scoreWeights(const std::map<int64_t, FeatureOutcome>& features) {
       ++s.moving;
       moving_low += f.weight < 0.5f;
     } else {
-      ++s.static_;
+      ++s.stationary;
       static_high += f.weight > 0.5f;
     }
   }
   s.moving_rejected = s.moving ? static_cast<double>(moving_low) / s.moving : 0;
-  s.static_kept = s.static_ ? static_cast<double>(static_high) / s.static_ : 0;
+  s.static_kept = s.stationary ? static_cast<double>(static_high) / s.stationary : 0;
   return s;
 }
 

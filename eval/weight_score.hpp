@@ -15,12 +15,12 @@ struct FeatureOutcome {
 };
 
 struct WeightScore {
-  int moving = 0, static_ = 0;  ///< labelled features that went through at least one solve
+  int moving = 0, stationary = 0;  ///< labelled features that went through at least one solve
   double moving_rejected = 0;   ///< share of `moving` with weight < 0.5
-  double static_kept = 0;       ///< share of `static_` with weight > 0.5
+  double static_kept = 0;       ///< share of `stationary` with weight > 0.5
 };
 
 /// Scores features (by id) that went through at least one solve; unlabelled ones are left out.
-WeightScore scoreWeights(const std::map<int64_t, FeatureOutcome>& features);
+WeightScore score_weights(const std::map<int64_t, FeatureOutcome>& features);
 
 }  // namespace dynavins::eval

@@ -33,12 +33,12 @@ const char kPinhole[] =
 }  // namespace
 
 extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, std::size_t size) {
-  static const bool camera_written = [] {
+  static const bool kCameraWritten = [] {
     dynavins::fuzz::write_fuzz_file("config/cam_pinhole.yaml", reinterpret_cast<const uint8_t*>(kPinhole),
                                     sizeof(kPinhole) - 1);
     return true;
   }();
-  (void)camera_written;
+  (void)kCameraWritten;
   const std::string path = dynavins::fuzz::write_fuzz_file("config/config.yaml", data, size);
   try {
     const dynavins::EstimatorOptions options = dynavins::EstimatorOptions::load(path);

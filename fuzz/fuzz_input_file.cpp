@@ -11,7 +11,7 @@
 namespace dynavins::fuzz {
 
 const std::string& fuzz_scratch_dir() {
-  static const std::string dir = [] {
+  static const std::string kDir = [] {
     // The readers warn about what they skip; at thousands of inputs a second that is only noise.
     spdlog::set_level(spdlog::level::off);
     const char* tmp = std::getenv("TMPDIR");
@@ -20,7 +20,7 @@ const std::string& fuzz_scratch_dir() {
     std::filesystem::create_directories(d);
     return d.string();
   }();
-  return dir;
+  return kDir;
 }
 
 std::string write_fuzz_file(const std::string& name, const uint8_t* data, std::size_t size) {

@@ -1,7 +1,7 @@
 #pragma once
 // LCM channel names used in logs and live (one place, so logs, lcm-spy and subscribers agree).
 
-namespace dynavins::channels {
+namespace dynavins::pipeline::channels {
 
 // Inputs (recorded sensor logs, live sensors)
 inline constexpr const char* kStereo = "CAM_STEREO";           // stereo_image_t
@@ -18,4 +18,4 @@ inline constexpr const char* kPath = "DYNAVINS_PATH";             // path_t
 inline constexpr const char* kStats = "DYNAVINS_STATS";           // pipeline_stats_t, once a second
 inline constexpr const char* kStatus = "DYNAVINS_STATUS";         // status_t, on change and once a second
 
-}  // namespace dynavins::channels
+}  // namespace dynavins::pipeline::channels

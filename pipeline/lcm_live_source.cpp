@@ -46,10 +46,10 @@ LcmLiveSource::LcmLiveSource(lcm::LCM& lcm, LiveSourceOptions options, const std
 }
 
 void LcmLiveSource::subscribe() {
-  subscriptions_.push_back(lcm_->subscribe(opt_.stereo_channel, &LcmLiveSource::onStereo, this));
-  subscriptions_.push_back(lcm_->subscribe(opt_.imu_channel, &LcmLiveSource::onImu, this));
+  subscriptions_.push_back(lcm_->subscribe(opt_.stereo_channel, &LcmLiveSource::on_stereo, this));
+  subscriptions_.push_back(lcm_->subscribe(opt_.imu_channel, &LcmLiveSource::on_imu, this));
   if (!opt_.ground_truth_channel.empty())
-    subscriptions_.push_back(lcm_->subscribe(opt_.ground_truth_channel, &LcmLiveSource::onGroundTruth, this));
+    subscriptions_.push_back(lcm_->subscribe(opt_.ground_truth_channel, &LcmLiveSource::on_ground_truth, this));
 }
 
 LcmLiveSource::~LcmLiveSource() {
@@ -60,7 +60,7 @@ std::string LcmLiveSource::describe() const {
   return "live LCM " + opt_.url + " (" + opt_.stereo_channel + ", " + opt_.imu_channel + ")";
 }
 
-bool LcmLiveSource::stopRequested() const {
+bool LcmLiveSource::stop_requested() const {
   return interrupt_requested() || (stop_ && stop_->load(std::memory_order_relaxed));
 }
 
@@ -68,7 +68,7 @@ void LcmLiveSource::reject(int64_t& counter, const std::string& channel, const s
   if (counter++ == 0) spdlog::warn("live: {} on {} (rejected; further ones are counted)", why, channel);
 }
 
-void LcmLiveSource::onStereo(const lcm::ReceiveBuffer* rbuf, const std::string& channel) {
+void LcmLiveSource::on_stereo(const lcm::ReceiveBuffer* rbuf, const std::string& channel) {
   dynavins_lcm::stereo_image_t msg;
   bool wrong_type = false;
   if (!decode(rbuf, msg, wrong_type))
@@ -91,7 +91,7 @@ void LcmLiveSource::onStereo(const lcm::ReceiveBuffer* rbuf, const std::string& 
   ++stats_.frames;
 }
 
-void LcmLiveSource::onImu(const lcm::ReceiveBuffer* rbuf, const std::string& channel) {
+void LcmLiveSource::on_imu(const lcm::ReceiveBuffer* rbuf, const std::string& channel) {
   dynavins_lcm::imu_t msg;
   bool wrong_type = false;
   if (!decode(rbuf, msg, wrong_type))
@@ -109,7 +109,7 @@ void LcmLiveSource::onImu(const lcm::ReceiveBuffer* rbuf, const std::string& cha
   ++stats_.imu;
 }
 
-void LcmLiveSource::onGroundTruth(const lcm::ReceiveBuffer* rbuf, const std::string& channel) {
+void LcmLiveSource::on_ground_truth(const lcm::ReceiveBuffer* rbuf, const std::string& channel) {
   dynavins_lcm::ground_truth_t msg;
   bool wrong_type = false;
   if (!decode(rbuf, msg, wrong_type))
@@ -130,7 +130,7 @@ void LcmLiveSource::onGroundTruth(const lcm::ReceiveBuffer* rbuf, const std::str
 
 bool LcmLiveSource::next(SensorEvent& out) {
   while (ready_.empty()) {
-    if (stopRequested()) return false;
+    if (stop_requested()) return false;
     if (lcm_->handleTimeout(kPollMs) < 0) throw std::runtime_error("LCM receive failed on " + opt_.url);
   }
   out = std::move(ready_.front());

@@ -64,11 +64,11 @@ class LcmLiveSource final : public io::SensorSource {
   const LiveSourceStats& stats() const { return stats_; }
 
  private:
-  void onStereo(const lcm::ReceiveBuffer* rbuf, const std::string& channel);
-  void onImu(const lcm::ReceiveBuffer* rbuf, const std::string& channel);
-  void onGroundTruth(const lcm::ReceiveBuffer* rbuf, const std::string& channel);
+  void on_stereo(const lcm::ReceiveBuffer* rbuf, const std::string& channel);
+  void on_imu(const lcm::ReceiveBuffer* rbuf, const std::string& channel);
+  void on_ground_truth(const lcm::ReceiveBuffer* rbuf, const std::string& channel);
   void reject(int64_t& counter, const std::string& channel, const std::string& why);
-  bool stopRequested() const;
+  bool stop_requested() const;
 
   LiveSourceOptions opt_;
   const std::atomic<bool>* stop_;

@@ -17,12 +17,12 @@ namespace {
 
 constexpr int64_t kPeriodNs = 1'000'000'000;  // stats and status once a second
 
-int64_t wallUtime() {
+int64_t wall_utime() {
   return std::chrono::duration_cast<std::chrono::microseconds>(std::chrono::system_clock::now().time_since_epoch())
       .count();
 }
 
-dynavins_lcm::status_t toLcm(const StatusUpdate& s) {
+dynavins_lcm::status_t to_lcm(const StatusUpdate& s) {
   dynavins_lcm::status_t m;
   m.utime = ns_to_utime(s.t_ns);
   m.status = static_cast<int8_t>(s.status);
@@ -112,32 +112,32 @@ void LcmPublisher::process(PublishItem item) {
           send(channels_.loops, to_lcm(x), stats_.hypotheses);
         } else {
           // A change (new status or an event) goes out at once; otherwise the status is only
-          // refreshed, and publishPeriodic() sends it with the reason of the change that led to it.
+          // refreshed, and publish_periodic() sends it with the reason of the change that led to it.
           const bool change = !last_status_ || x.status != last_status_->status || !x.reason.empty();
           if (!change) x.reason = last_status_->reason;
           last_status_ = x;
-          if (change) publishStatus();
+          if (change) publish_status();
         }
       },
       item.payload);
   const int64_t now = steady_now_ns();
-  if (now >= next_periodic_ns_) publishPeriodic(now);
+  if (now >= next_periodic_ns_) publish_periodic(now);
 }
 
-void LcmPublisher::publishStatus() {
-  if (last_status_) send(channels_.status, toLcm(*last_status_), stats_.status);
+void LcmPublisher::publish_status() {
+  if (last_status_) send(channels_.status, to_lcm(*last_status_), stats_.status);
 }
 
-void LcmPublisher::publishPeriodic(int64_t now_ns) {
+void LcmPublisher::publish_periodic(int64_t now_ns) {
   next_periodic_ns_ = now_ns + kPeriodNs;
   if (snapshot_) {
     const double sensor_s = first_t_ns_ ? static_cast<double>(last_t_ns_ - *first_t_ns_) / 1e9 : 0.0;
-    send(channels_.stats, to_lcm(snapshot_(), wallUtime(), sensor_s), stats_.stats);
+    send(channels_.stats, to_lcm(snapshot_(), wall_utime(), sensor_s), stats_.stats);
   }
-  publishStatus();
+  publish_status();
 }
 
-void LcmPublisher::finish() { publishPeriodic(steady_now_ns()); }
+void LcmPublisher::finish() { publish_periodic(steady_now_ns()); }
 
 PublisherStats LcmPublisher::stats() const {
   PublisherStats s = stats_;

@@ -72,8 +72,8 @@ class LcmPublisher {
   PublisherStats stats() const;
 
  private:
-  void publishPeriodic(int64_t now_ns);
-  void publishStatus();
+  void publish_periodic(int64_t now_ns);
+  void publish_status();
   template <typename Msg>
   void send(const std::string& channel, const Msg& msg, int64_t& counter);
 

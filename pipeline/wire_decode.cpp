@@ -123,7 +123,7 @@ bool walk_stats(WireCursor& c) {  // pipeline_stats_t: utime, wall_s, realtime_f
 }  // namespace
 
 std::string wire_length_problem(const std::string& type_name, const uint8_t* data, std::size_t size) {
-  static const std::map<std::string, std::function<bool(WireCursor&)>> walkers = {
+  static const std::map<std::string, std::function<bool(WireCursor&)>> kWalkers = {
       {"image_t", walk_image},
       {"stereo_image_t", walk_stereo},
       {"weighted_feature_set_t", walk_feature_set},
@@ -132,8 +132,8 @@ std::string wire_length_problem(const std::string& type_name, const uint8_t* dat
       {"status_t", walk_status},
       {"pipeline_stats_t", walk_stats},
   };
-  const auto it = walkers.find(type_name);
-  if (it == walkers.end()) return {};
+  const auto it = kWalkers.find(type_name);
+  if (it == kWalkers.end()) return {};
   WireCursor c(data, size);
   if (!c.skip(8, "fingerprint") || !it->second(c)) return c.problem();
   // A walk that ends elsewhere than the payload's end: trailing bytes (or a layout here out of step

@@ -25,8 +25,8 @@ struct EstimateRecorder {
 };
 
 /// The source's ground truth as a trajectory (time order, repeated stamps skipped).
-eval::Trajectory groundTruthTrajectory(const std::vector<GroundTruthState>& states);
+eval::Trajectory ground_truth_trajectory(const std::vector<GroundTruthState>& states);
 /// |v_wb| by time, for the states that carry a velocity.
-std::map<int64_t, double> groundTruthSpeed(const std::vector<GroundTruthState>& states);
+std::map<int64_t, double> ground_truth_speed(const std::vector<GroundTruthState>& states);
 
 }  // namespace dynavins::pipeline

@@ -4,14 +4,14 @@
 
 namespace dynavins::pipeline {
 
-std::optional<TrackerInput> FrameImuAttacher::addImu(const ImuSample& s) {
+std::optional<TrackerInput> FrameImuAttacher::add_imu(const ImuSample& s) {
   imu_.push_back(s);
   if (held_ && s.t_ns >= held_->t_ns) return release();
   if (!held_ && imu_.size() > max_buffered_) imu_.erase(imu_.begin(), imu_.end() - max_buffered_);
   return std::nullopt;
 }
 
-std::optional<TrackerInput> FrameImuAttacher::addFrame(StereoFrame&& f) {
+std::optional<TrackerInput> FrameImuAttacher::add_frame(StereoFrame&& f) {
   std::optional<TrackerInput> out;
   if (held_) {
     ++released_incomplete_;

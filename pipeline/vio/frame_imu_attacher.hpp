@@ -29,15 +29,15 @@ class FrameImuAttacher {
   explicit FrameImuAttacher(std::size_t max_buffered = 4000) : max_buffered_(max_buffered) {}
 
   /// An IMU sample; returns the held frame when the sample reaches its time.
-  std::optional<TrackerInput> addImu(const ImuSample& s);
+  std::optional<TrackerInput> add_imu(const ImuSample& s);
   /// A new frame, which is held; returns the frame held before it, if no sample had reached that one's
   /// time (it goes with the samples there are, and the predictor will refuse them).
-  std::optional<TrackerInput> addFrame(StereoFrame&& f);
+  std::optional<TrackerInput> add_frame(StereoFrame&& f);
   /// End of input: the held frame, if any.
   std::optional<TrackerInput> finish();
 
   /// Frames handed over before an IMU sample had reached their time.
-  std::size_t releasedIncomplete() const { return released_incomplete_; }
+  std::size_t released_incomplete() const { return released_incomplete_; }
 
  private:
   TrackerInput release();

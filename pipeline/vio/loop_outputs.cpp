@@ -16,7 +16,7 @@ namespace {
 loop::RigidPose rigid(const eval::StampedPose& p) { return loop::RigidPose{p.p, p.q}; }
 
 /// The ground-truth pose nearest to t_ns, if one lies within 10 ms (truth sorted by time).
-std::optional<loop::RigidPose> truthAt(const eval::Trajectory& truth, int64_t t_ns) {
+std::optional<loop::RigidPose> truth_at(const eval::Trajectory& truth, int64_t t_ns) {
   const auto it = std::lower_bound(truth.poses.begin(), truth.poses.end(), t_ns,
                                    [](const eval::StampedPose& p, int64_t t) { return p.t_ns < t; });
   const eval::StampedPose* best = nullptr;
@@ -28,7 +28,7 @@ std::optional<loop::RigidPose> truthAt(const eval::Trajectory& truth, int64_t t_
 
 }  // namespace
 
-eval::Trajectory correctedTrajectory(const eval::Trajectory& odometry, const LoopRunSummary* loop) {
+eval::Trajectory corrected_trajectory(const eval::Trajectory& odometry, const LoopRunSummary* loop) {
   if (!loop) return odometry;
   std::vector<loop::StampedPose> in;
   in.reserve(odometry.poses.size());
@@ -36,11 +36,11 @@ eval::Trajectory correctedTrajectory(const eval::Trajectory& odometry, const Loo
   eval::Trajectory out;
   out.source = odometry.source;
   for (const loop::StampedPose& p : loop::correct_trajectory(in, loop->corrections))
-    out.poses.push_back(eval::stampedPose(p.t_ns, p.T_W_b.p, p.T_W_b.q));
+    out.poses.push_back(eval::stamped_pose(p.t_ns, p.T_W_b.p, p.T_W_b.q));
   return out;
 }
 
-LoopTruthCounts writeLoopsCsv(const std::string& path, const LoopRunSummary& loop, const eval::Trajectory& truth) {
+LoopTruthCounts write_loops_csv(const std::string& path, const LoopRunSummary& loop, const eval::Trajectory& truth) {
   std::ofstream f(path, std::ios::out | std::ios::trunc);
   f << "mode,query_t_ns,match_t_ns,inliers,group,group_first_t_ns,hypothesis,weight,used,true_loop,error_m,error_deg\n";
   LoopTruthCounts c;
@@ -48,7 +48,7 @@ LoopTruthCounts writeLoopsCsv(const std::string& path, const LoopRunSummary& loo
     const loop::LoopReportRow& r = loop.rows[i];
     f << loop::loop_mode_name(loop.mode) << ',' << r.query_t_ns << ',' << r.match_t_ns << ',' << r.inliers << ','
       << r.group << ',' << r.group_first_t_ns << ',' << r.hypothesis << ',' << r.weight << ',' << (r.used ? 1 : 0);
-    const auto m = truthAt(truth, r.match_t_ns), q = truthAt(truth, r.query_t_ns);
+    const auto m = truth_at(truth, r.match_t_ns), q = truth_at(truth, r.query_t_ns);
     if (m && q && i < loop.loops.size()) {
       // T_m^k from the truth against the loop's (eq. 13's relative pose).
       const loop::RigidPose truth_mq = loop::compose(loop::inverse(*m), *q);
@@ -68,7 +68,7 @@ LoopTruthCounts writeLoopsCsv(const std::string& path, const LoopRunSummary& loo
   return c;
 }
 
-std::string loopJson(const LoopRunSummary& l, const LoopTruthCounts& t, bool has_truth) {
+std::string loop_json(const LoopRunSummary& l, const LoopTruthCounts& t, bool has_truth) {
   std::ostringstream j;
   j << "{\"mode\": " << json_string(loop::loop_mode_name(l.mode)) << ", \"vocabulary\": " << json_string(l.vocabulary)
     << ", \"keyframes\": " << l.keyframes << ", \"keyframes_dropped\": " << l.keyframes_dropped

@@ -13,7 +13,7 @@ namespace dynavins::pipeline {
 
 /// The odometry corrected with the keyframe corrections (T_corr of the latest keyframe at or before each
 /// frame); the odometry itself without a loop summary.
-eval::Trajectory correctedTrajectory(const eval::Trajectory& odometry, const LoopRunSummary* loop);
+eval::Trajectory corrected_trajectory(const eval::Trajectory& odometry, const LoopRunSummary* loop);
 
 /// A loop is counted true when its relative pose T_m^k is within these of the ground truth's.
 inline constexpr double kTrueLoopMaxErrorM = 0.3, kTrueLoopMaxErrorDeg = 5.0;
@@ -26,9 +26,9 @@ struct LoopTruthCounts {
 
 /// Writes loops.csv to `path`; `truth` may be empty (no ground truth: the truth columns stay empty).
 /// Throws std::runtime_error naming the file on a write error.
-LoopTruthCounts writeLoopsCsv(const std::string& path, const LoopRunSummary& loop, const eval::Trajectory& truth);
+LoopTruthCounts write_loops_csv(const std::string& path, const LoopRunSummary& loop, const eval::Trajectory& truth);
 
 /// summary.json's "loop" object.
-std::string loopJson(const LoopRunSummary& loop, const LoopTruthCounts& truth, bool has_truth);
+std::string loop_json(const LoopRunSummary& loop, const LoopTruthCounts& truth, bool has_truth);
 
 }  // namespace dynavins::pipeline

@@ -1,7 +1,7 @@
 #pragma once
 // The loop-closure stage of the run (paper IV, DESIGN.md §2): keyframes the estimator let go, in time
 // order, into loop::LoopCloser; after the last one, the final optimisation. A plain object with
-// process()/finish(): runVio runs it on its own thread behind the keyframe queue, runVioSequential calls
+// process()/finish(): run_vio runs it on its own thread behind the keyframe queue, run_vio_sequential calls
 // it in line. What it found (corrections for every keyframe, the verified loops with their final
 // weights) is collected into the run's result for trajectory.tum and loops.csv.
 

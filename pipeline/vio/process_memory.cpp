@@ -4,7 +4,7 @@
 
 namespace dynavins::pipeline {
 
-double peakRssMb() {
+double peak_rss_mb() {
   rusage u{};
   if (getrusage(RUSAGE_SELF, &u) != 0) return 0.0;
   return static_cast<double>(u.ru_maxrss) / 1024.0;  // Linux reports kilobytes

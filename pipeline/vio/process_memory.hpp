@@ -4,6 +4,6 @@
 namespace dynavins::pipeline {
 
 /// Peak resident set size of the process so far [MB] (getrusage ru_maxrss); 0 if unavailable.
-double peakRssMb();
+double peak_rss_mb();
 
 }  // namespace dynavins::pipeline

@@ -49,7 +49,7 @@ double percentile(std::vector<double> v, double p) {
 }
 
 // An event text as one CSV field: quoted, inner quotes doubled, newlines flattened.
-std::string csvField(const std::string& s) {
+std::string csv_field(const std::string& s) {
   std::string out = "\"";
   for (char c : s) {
     if (c == '"') out += "\"\"";
@@ -59,14 +59,14 @@ std::string csvField(const std::string& s) {
   return out + "\"";
 }
 
-std::string tumLine(int64_t t_ns, const Eigen::Vector3d& p, const Eigen::Quaterniond& q) {
+std::string tum_line(int64_t t_ns, const Eigen::Vector3d& p, const Eigen::Quaterniond& q) {
   char buf[256];
-  std::snprintf(buf, sizeof buf, "%s %.9f %.9f %.9f %.9f %.9f %.9f %.9f\n", formatSeconds(t_ns).c_str(), p.x(),
+  std::snprintf(buf, sizeof buf, "%s %.9f %.9f %.9f %.9f %.9f %.9f %.9f\n", format_seconds(t_ns).c_str(), p.x(),
                 p.y(), p.z(), q.x(), q.y(), q.z(), q.w());
   return buf;
 }
 
-AteResult evaluateAte(const eval::Trajectory& gt, const eval::Trajectory& est) {
+AteResult evaluate_ate(const eval::Trajectory& gt, const eval::Trajectory& est) {
   AteResult a;
   try {
     eval::EvalOptions o;
@@ -86,7 +86,7 @@ AteResult evaluateAte(const eval::Trajectory& gt, const eval::Trajectory& est) {
 
 }  // namespace
 
-std::string formatSeconds(int64_t t_ns) {
+std::string format_seconds(int64_t t_ns) {
   const bool neg = t_ns < 0;
   const unsigned long long a =
       neg ? static_cast<unsigned long long>(-(t_ns + 1)) + 1 : static_cast<unsigned long long>(t_ns);
@@ -137,14 +137,14 @@ void RunOutputs::write(const estimator::WindowEstimate& e) {
   }
   if (!e.event.empty()) {
     ++totals_.events;
-    events_ << e.t_ns << ',' << e.seq << ',' << csvField(e.event) << '\n';
+    events_ << e.t_ns << ',' << e.seq << ',' << csv_field(e.event) << '\n';
     check(events_, kEvents);
   }
   if (e.status != estimator::EstimatorStatus::Tracking) return;
   ++totals_.tracking;
-  odometry_ << tumLine(e.t_ns, e.state.p_wb, e.state.q_wb);
+  odometry_ << tum_line(e.t_ns, e.state.p_wb, e.state.q_wb);
   check(odometry_, kOdometry);
-  estimated_.poses.push_back(eval::stampedPose(e.t_ns, e.state.p_wb, e.state.q_wb));
+  estimated_.poses.push_back(eval::stamped_pose(e.t_ns, e.state.p_wb, e.state.q_wb));
   char buf[320];
   for (const WeightedFeature& f : e.features.features) {
     int n = std::snprintf(buf, sizeof buf, "%" PRId64 ",%" PRId64 ",%" PRId64 ",%.3f,%.3f,%.6f,%d,%d,%.6f,%.6f,%.6f,",
@@ -168,15 +168,15 @@ void RunOutputs::complete(const VioRunResult& run, const RunDescription& what) {
     gt << "# t[s] x y z qx qy qz qw (ground truth of the source, body in world)\n";
     truth.source = path(kGroundTruth);
     for (const GroundTruthState& g : run.ground_truth) {
-      gt << tumLine(g.t_ns, g.p_wb, g.q_wb);
-      if (truth.poses.empty() || g.t_ns > truth.poses.back().t_ns) truth.poses.push_back(eval::stampedPose(g.t_ns, g.p_wb, g.q_wb));
+      gt << tum_line(g.t_ns, g.p_wb, g.q_wb);
+      if (truth.poses.empty() || g.t_ns > truth.poses.back().t_ns) truth.poses.push_back(eval::stamped_pose(g.t_ns, g.p_wb, g.q_wb));
     }
     gt.flush();
     check(gt, kGroundTruth);
     written_.push_back(kGroundTruth);
     if (!estimated_.empty()) {
       estimated_.source = path(kOdometry);
-      ate_ = evaluateAte(truth, estimated_);
+      ate_ = evaluate_ate(truth, estimated_);
     }
   }
   for (auto* f : {&odometry_, &features_, &events_}) {
@@ -186,26 +186,26 @@ void RunOutputs::complete(const VioRunResult& run, const RunDescription& what) {
   }
   // trajectory.tum: after the final pose-graph optimisation (the odometry when loop closure is off).
   const LoopRunSummary* loop = run.loop ? &*run.loop : nullptr;
-  const eval::Trajectory trajectory = correctedTrajectory(estimated_, loop);
+  const eval::Trajectory trajectory = corrected_trajectory(estimated_, loop);
   {
     std::ofstream t(path(kTrajectory) + kPartial, std::ios::out | std::ios::trunc);
     t << "# t[s] x y z qx qy qz qw (every frame after the final pose-graph optimisation; the odometry without loops)\n";
-    for (const eval::StampedPose& p : trajectory.poses) t << tumLine(p.t_ns, p.p, p.q);
+    for (const eval::StampedPose& p : trajectory.poses) t << tum_line(p.t_ns, p.p, p.q);
     t.flush();
     check(t, kTrajectory);
     written_.push_back(kTrajectory);
   }
-  std::string loop_json;
+  std::string loop_section;
   if (loop) {
-    const LoopTruthCounts counts = writeLoopsCsv(path(kLoops) + kPartial, *loop, truth);
+    const LoopTruthCounts counts = write_loops_csv(path(kLoops) + kPartial, *loop, truth);
     written_.push_back(kLoops);
-    loop_json = loopJson(*loop, counts, has_gt);
-    if (has_gt && !trajectory.empty()) trajectory_ate_ = evaluateAte(truth, trajectory);
+    loop_section = loop_json(*loop, counts, has_gt);
+    if (has_gt && !trajectory.empty()) trajectory_ate_ = evaluate_ate(truth, trajectory);
   }
-  summary_ = pipeline::summaryJson(run, what, totals_, ate_, totals_.tracking, has_gt);
+  summary_ = pipeline::summary_json(run, what, totals_, ate_, totals_.tracking, has_gt);
   if (loop) {  // the loop section goes in front of the pipeline report, the last key
     const std::string tail = "  \"pipeline\": ";
-    std::string section = "  \"loop\": " + loop_json + ",\n";
+    std::string section = "  \"loop\": " + loop_section + ",\n";
     if (trajectory_ate_.evaluated)
       section += "  \"trajectory_ate_se3_m\": " + num(trajectory_ate_.se3_m) + ",\n  \"trajectory_ate_sim3_m\": " +
                  num(trajectory_ate_.sim3_m) + ",\n";
@@ -221,7 +221,7 @@ void RunOutputs::complete(const VioRunResult& run, const RunDescription& what) {
   for (const std::string& name : written_) fs::rename(path(name) + kPartial, path(name));
 }
 
-std::string summaryJson(const VioRunResult& run, const RunDescription& what, const EstimateTotals& totals,
+std::string summary_json(const VioRunResult& run, const RunDescription& what, const EstimateTotals& totals,
                         const AteResult& ate, int64_t odometry_lines, bool has_ground_truth) {
   std::ostringstream j;
   const double wall = run.report.wall_s, data = run.replay.sensor_s;
@@ -281,7 +281,7 @@ std::string summaryJson(const VioRunResult& run, const RunDescription& what, con
   j << "  \"wall_s\": " << num(wall) << ",\n";
   j << "  \"data_s\": " << num(data) << ",\n";
   j << "  \"real_time_factor\": " << num(wall > 0 ? data / wall : 0.0) << ",\n";
-  j << "  \"peak_rss_mb\": " << num(peakRssMb()) << ",\n";
+  j << "  \"peak_rss_mb\": " << num(peak_rss_mb()) << ",\n";
   j << "  \"has_ground_truth\": " << (has_ground_truth ? "true" : "false") << ",\n";
   if (ate.evaluated) {
     j << "  \"ate_se3_m\": " << num(ate.se3_m) << ",\n";

@@ -67,9 +67,9 @@ class RunOutputs {
   const EstimateTotals& totals() const { return totals_; }
   /// Filled by complete(): the odometry's ATE, and trajectory.tum's (with loop closure on).
   const AteResult& ate() const { return ate_; }
-  const AteResult& trajectoryAte() const { return trajectory_ate_; }
+  const AteResult& trajectory_ate() const { return trajectory_ate_; }
   /// Filled by complete(): the summary.json text.
-  const std::string& summaryJson() const { return summary_; }
+  const std::string& summary_json() const { return summary_; }
 
  private:
   std::string path(const std::string& name) const;
@@ -85,10 +85,10 @@ class RunOutputs {
 };
 
 /// `t_ns` as seconds with exactly 9 decimals, without floating-point rounding.
-std::string formatSeconds(int64_t t_ns);
+std::string format_seconds(int64_t t_ns);
 
 /// Builds summary.json's text from the run and what was written.
-std::string summaryJson(const VioRunResult& run, const RunDescription& what, const EstimateTotals& totals,
+std::string summary_json(const VioRunResult& run, const RunDescription& what, const EstimateTotals& totals,
                         const AteResult& ate, int64_t odometry_lines, bool has_ground_truth);
 
 }  // namespace dynavins::pipeline

@@ -28,27 +28,27 @@ using estimator::WindowEstimate;
 /// false when the run is aborted; `poll` runs before every event (stop requests).
 struct ReplayRouting {
   bool predict = false;
-  std::function<bool(ImuStageInput)> push_imu;
+  std::function<bool(imu::ImuStageInput)> push_imu;
   std::function<bool(TrackerInput)> push_frame;
   std::function<void()> poll;
   std::vector<GroundTruthState>* ground_truth = nullptr;
   FrameImuAttacher attacher;
 
-  bool pushAttached(std::optional<TrackerInput> f) { return !f || push_frame(std::move(*f)); }
+  bool push_attached(std::optional<TrackerInput> f) { return !f || push_frame(std::move(*f)); }
 
   ReplaySinks sinks() {
     ReplaySinks s;
     s.frame = [this](StereoFrame&& f) {
       poll();
-      if (!push_imu(FrameTime{f.t_ns})) return false;
+      if (!push_imu(imu::FrameTime{f.t_ns})) return false;
       if (!predict) return push_frame(TrackerInput{std::move(f), {}});
-      return pushAttached(attacher.addFrame(std::move(f)));
+      return push_attached(attacher.add_frame(std::move(f)));
     };
     s.imu = [this](ImuSample&& x) {
       poll();
       if (!predict) return push_imu(std::move(x));
       const ImuSample copy = x;
-      return push_imu(std::move(x)) && pushAttached(attacher.addImu(copy));
+      return push_imu(std::move(x)) && push_attached(attacher.add_imu(copy));
     };
     s.ground_truth = [this](GroundTruthState&& g) {
       ground_truth->push_back(std::move(g));
@@ -57,12 +57,12 @@ struct ReplayRouting {
     return s;
   }
   /// End of the replay: the frame still waiting for its IMU goes on without it.
-  void finish() { pushAttached(attacher.finish()); }
+  void finish() { push_attached(attacher.finish()); }
 };
 
 /// The loop closer's output for the publisher: after an optimisation the keyframe path and each group's
 /// hypotheses; always the newest drift, for the loop-corrected window pose.
-void publishLoopOutput(const loop::LoopCloserOutput& out, const loop::LoopCloser& closer,
+void publish_loop_output(const loop::LoopCloserOutput& out, const loop::LoopCloser& closer,
                        FanInQueue<PublishItem>::Producer& pub, LatestValue<loop::RigidPose>& drift) {
   drift.write(out.drift);
   if (!out.optimized) return;
@@ -99,7 +99,7 @@ void publishLoopOutput(const loop::LoopCloserOutput& out, const loop::LoopCloser
   pub.push(PublishItem{0, std::move(path)});
 }
 
-void countFrames(VioRunResult& result) {
+void count_frames(VioRunResult& result) {
   for (const auto& q : result.report.queues)
     if (q.name == "frames") result.frames_dropped = static_cast<int64_t>(q.dropped);
   for (const auto& s : result.report.stages)
@@ -108,7 +108,7 @@ void countFrames(VioRunResult& result) {
 
 }  // namespace
 
-void checkVioOptions(const VioRunOptions& o) {
+void check_vio_options(const VioRunOptions& o) {
   if (!o.estimator.use_imu) throw std::invalid_argument("the config says imu: 0; `run` needs the IMU");
   if (o.estimator.cameras.empty()) throw std::invalid_argument("the config loads no camera");
   if (o.mode.stereo && (o.estimator.num_of_cam < 2 || o.estimator.cameras.size() < 2))
@@ -120,17 +120,17 @@ void checkVioOptions(const VioRunOptions& o) {
     throw std::invalid_argument("queue capacities must be positive");
 }
 
-VioRunResult runVio(io::SensorSource& source, const VioRunOptions& opt, const VioSinks& sinks,
+VioRunResult run_vio(io::SensorSource& source, const VioRunOptions& opt, const VioSinks& sinks,
                     const StopFlag* external_stop) {
-  checkVioOptions(opt);
-  const bool paced = opt.realTime();
+  check_vio_options(opt);
+  const bool paced = opt.real_time();
   VioRunResult result;
   result.source = source.describe();
   VioStages st(opt, sinks.tracked, sinks.estimate);
 
   Pipeline p;
   auto& frames = p.add_queue<TrackerInput>("frames", opt.frame_queue, paced ? Backpressure::DropOldest : Backpressure::Block);
-  auto& imu_in = p.add_queue<ImuStageInput>("imu", opt.imu_queue, Backpressure::Block);
+  auto& imu_in = p.add_queue<imu::ImuStageInput>("imu", opt.imu_queue, Backpressure::Block);
   auto& est_in = p.add_fan_in<EstimatorInput>("estimator_in", opt.estimator_queue, Backpressure::Block);
   auto& estimates = p.add_queue<WindowEstimate>("estimates", opt.output_queue, Backpressure::Block);
   auto from_tracker = est_in.make_producer();
@@ -169,7 +169,7 @@ VioRunResult runVio(io::SensorSource& source, const VioRunOptions& opt, const Vi
           }
         };
         // IMU input is never dropped: paced, a full queue is an error rather than a silent wait.
-        route.push_imu = [&](ImuStageInput x) {
+        route.push_imu = [&](imu::ImuStageInput x) {
           if (paced ? imu_in.try_push(std::move(x)) : imu_in.push(std::move(x))) return true;
           if (stop.aborted()) return false;
           throw std::runtime_error("IMU queue full: the IMU stage fell behind (IMU is never dropped)");
@@ -193,7 +193,7 @@ VioRunResult runVio(io::SensorSource& source, const VioRunOptions& opt, const Vi
   std::unique_ptr<FanInQueue<PublishItem>::Producer> loop_pub;
   if (publisher && st.loop) {
     loop_pub = publish_q->make_producer();
-    st.loop->on_output = [&](const loop::LoopCloserOutput& out) { publishLoopOutput(out, st.loop->closer(), *loop_pub, drift); };
+    st.loop->on_output = [&](const loop::LoopCloserOutput& out) { publish_loop_output(out, st.loop->closer(), *loop_pub, drift); };
     st.writer.correct = [&drift](const NavState& s) -> std::optional<NavState> {
       const auto d = drift.read();
       if (!d) return std::nullopt;
@@ -228,7 +228,7 @@ VioRunResult runVio(io::SensorSource& source, const VioRunOptions& opt, const Vi
   });
   if (publisher) p.add_stage("publisher", *publisher, *publish_q, NoOutput{}, {});
   // The source too: live, it drains the sensor socket, and a starved reader loses IMU packets in the kernel.
-  if (opt.realTime() && opt.realtime_priority > 0) {
+  if (opt.real_time() && opt.realtime_priority > 0) {
     p.set_thread_realtime("replay", opt.realtime_priority);
     p.set_thread_realtime("imu", opt.realtime_priority);
     if (publisher) p.set_thread_realtime("publisher", opt.realtime_priority);
@@ -242,16 +242,16 @@ VioRunResult runVio(io::SensorSource& source, const VioRunOptions& opt, const Vi
     for (const auto& q : result.report.queues)
       if (q.name == "publish") result.publish_dropped = static_cast<int64_t>(q.dropped);
   }
-  countFrames(result);
+  count_frames(result);
   st.collect(result);
   return result;
 }
 
-VioRunResult runVioSequential(io::SensorSource& source, const VioRunOptions& opt, const VioSinks& sinks,
+VioRunResult run_vio_sequential(io::SensorSource& source, const VioRunOptions& opt, const VioSinks& sinks,
                               const StopFlag* external_stop) {
-  checkVioOptions(opt);
+  check_vio_options(opt);
   if (opt.rate != 0) throw std::invalid_argument("the sequential run replays as fast as possible: rate must be 0");
-  if (!opt.lcm_url.empty()) throw std::invalid_argument("the sequential run does not publish: use runVio for lcm_url");
+  if (!opt.lcm_url.empty()) throw std::invalid_argument("the sequential run does not publish: use run_vio for lcm_url");
   VioRunResult result;
   result.source = source.describe();
   VioStages st(opt, sinks.tracked, sinks.estimate);
@@ -286,7 +286,7 @@ VioRunResult runVioSequential(io::SensorSource& source, const VioRunOptions& opt
       stop.request_stop();
     }
   };
-  route.push_imu = [&](ImuStageInput x) {
+  route.push_imu = [&](imu::ImuStageInput x) {
     stage = "imu";
     for (PreintegratedInterval& iv : st.imu.process(std::move(x))) toEstimator(std::move(iv));
     stage = "replay";

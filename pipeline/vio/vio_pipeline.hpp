@@ -16,9 +16,9 @@
 //
 // rate 0: every queue blocks (lossless, repeatable); rate > 0: the frame queue drops the oldest frames
 // when the tracker falls behind (counted). IMU is never dropped: a full IMU queue in real time is an error.
-// End of input, SIGINT or a stop request drain every queue before runVio() returns.
+// End of input, SIGINT or a stop request drain every queue before run_vio() returns.
 //
-// runVioSequential() is the same run on the caller's thread (Kimera-VIO's spinSequential beside
+// run_vio_sequential() is the same run on the caller's thread (Kimera-VIO's spinSequential beside
 // launchThreads): the same stages (vio_stages.hpp), built the same way, fed in the replay's order, with no
 // queues between them. At rate 0 both give the same trajectory bit for bit (tests/vio/test_vio_sequential.cpp);
 // tests and benches that need one answer every time, or a hook after the tracker, use it.
@@ -54,10 +54,10 @@ struct VioRunOptions {
   /// The source is live (it delivers in real time by itself): no pacing, but real-time back-pressure
   /// (oldest frames dropped when the tracker falls behind, solver time budget on). rate must be 0.
   bool live = false;
-  bool realTime() const { return rate > 0 || live; }
+  bool real_time() const { return rate > 0 || live; }
   bool show_progress = true;         ///< replay progress line on the terminal
   double imu_rate_hz = 200.0;        ///< nominal IMU rate (gap detection)
-  ImuNoiseConvention imu_noise = ImuNoiseConvention::VinsFusion;
+  imu::ImuNoiseConvention imu_noise = imu::ImuNoiseConvention::VinsFusion;
   std::size_t frame_queue = 8;       ///< stereo frames waiting for the tracker
   std::size_t imu_queue = 4000;      ///< IMU samples and frame times waiting for the IMU stage
   std::size_t estimator_queue = 64;  ///< tracked frames and intervals waiting for the estimator
@@ -119,9 +119,9 @@ struct VioRunResult {
   int64_t features_tracked = 0;    ///< features carried over from the previous frame, summed over frames
   int64_t features_lost_flow = 0;  ///< tracks lost by KLT (failed or left the image), summed over frames
   int64_t features_lost_back = 0;  ///< tracks lost by the forward-backward check, summed over frames
-  ImuStageStats imu;
-  ImuIntervalBuilderStats imu_builder;
-  FrameImuPairerStats pairer;
+  imu::ImuStageStats imu;
+  imu::ImuIntervalBuilderStats imu_builder;
+  imu::FrameImuPairerStats pairer;
   std::vector<GroundTruthState> ground_truth;  ///< the source's ground truth, in time order
   std::optional<PublisherStats> publisher;     ///< what was published (with lcm_url)
   int64_t publish_dropped = 0;                 ///< items the full publish queue dropped
@@ -130,21 +130,21 @@ struct VioRunResult {
 };
 
 /// Throws std::invalid_argument naming the problem when `options` cannot run (stereo without cam1,
-/// no IMU, negative rate, zero queue capacity). runVio() calls it first; callers may call it before
+/// no IMU, negative rate, zero queue capacity). run_vio() calls it first; callers may call it before
 /// creating outputs.
-void checkVioOptions(const VioRunOptions& options);
+void check_vio_options(const VioRunOptions& options);
 
 /// Runs `source` through tracker, IMU stage and estimator until its end, SIGINT or `external_stop`
 /// (may be null; polled by the replay thread). Blocks until every thread has ended. Throws
 /// std::invalid_argument for options that cannot run (stereo without cam1, no IMU); a failure inside
 /// a thread is returned in result.report (ok == false, error, failed_thread).
-VioRunResult runVio(io::SensorSource& source, const VioRunOptions& options, const VioSinks& sinks,
+VioRunResult run_vio(io::SensorSource& source, const VioRunOptions& options, const VioSinks& sinks,
                     const StopFlag* external_stop = nullptr);
 
 /// The same run on the caller's thread, one input at a time in the replay's order (rate must be 0).
 /// Stops at the source's end, SIGINT or `external_stop`. A stage's exception is returned in result.report
-/// like runVio's (failed_thread names the stage); result.report.stages/queues stay empty.
-VioRunResult runVioSequential(io::SensorSource& source, const VioRunOptions& options, const VioSinks& sinks,
+/// like run_vio's (failed_thread names the stage); result.report.stages/queues stay empty.
+VioRunResult run_vio_sequential(io::SensorSource& source, const VioRunOptions& options, const VioSinks& sinks,
                               const StopFlag* external_stop = nullptr);
 
 }  // namespace dynavins::pipeline

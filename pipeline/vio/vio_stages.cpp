@@ -13,7 +13,7 @@
 
 namespace dynavins::pipeline {
 
-TrackerStage::TrackerStage(StereoTracker t, bool mono_, std::optional<GyroRotationPredictor> g,
+TrackerStage::TrackerStage(tracker::StereoTracker t, bool mono_, std::optional<tracker::GyroRotationPredictor> g,
                            LatestValue<Eigen::Vector3d>& b, std::function<void(const TrackedFrame&)> cb)
     : tracker(std::move(t)), mono(mono_), gyro(std::move(g)), gyro_bias(b), on_tracked(std::move(cb)) {}
 
@@ -37,10 +37,10 @@ TrackedFrame TrackerStage::process(TrackerInput in) {
   return out;
 }
 
-std::vector<PreintegratedInterval> ImuFeedbackStage::process(ImuStageInput in) {
+std::vector<PreintegratedInterval> ImuFeedbackStage::process(imu::ImuStageInput in) {
   const int64_t origin_ns = on_imu_pose ? steady_now_ns() : 0;
   const auto s = latest.read();
-  if (s) stage.setBiases(s->bias_acc, s->bias_gyr);
+  if (s) stage.set_biases(s->bias_acc, s->bias_gyr);
   if (on_imu_pose) {
     if (s && s->t_ns != propagated_from_ns) {
       propagator.reset(*s);
@@ -48,21 +48,21 @@ std::vector<PreintegratedInterval> ImuFeedbackStage::process(ImuStageInput in) {
     }
     const auto* sample = std::get_if<ImuSample>(&in);
     if (sample && s && sample->t_ns - propagated_from_ns <= max_propagation_ns)
-      if (const auto p = propagator.addImu(*sample)) on_imu_pose(PoseEstimate{PoseSource::ImuRate, *p}, origin_ns);
+      if (const auto p = propagator.add_imu(*sample)) on_imu_pose(PoseEstimate{PoseSource::ImuRate, *p}, origin_ns);
   }
   return stage.process(in);
 }
 
 std::vector<estimator::WindowEstimate> EstimatorStage::process(estimator::EstimatorInput in) {
-  std::vector<FrameWithImu> ready =
-      std::visit([this](auto&& x) -> std::vector<FrameWithImu> {
+  std::vector<imu::FrameWithImu> ready =
+      std::visit([this](auto&& x) -> std::vector<imu::FrameWithImu> {
         using T = std::decay_t<decltype(x)>;
-        if constexpr (std::is_same_v<T, TrackedFrame>) return pairer.addFrame(std::move(x));
-        else return pairer.addInterval(std::move(x));
+        if constexpr (std::is_same_v<T, TrackedFrame>) return pairer.add_frame(std::move(x));
+        else return pairer.add_interval(std::move(x));
       }, std::move(in));
   std::vector<estimator::WindowEstimate> out;
   out.reserve(ready.size());
-  for (FrameWithImu& f : ready) {
+  for (imu::FrameWithImu& f : ready) {
     out.push_back(estimator.process(f.frame, f.imu ? &*f.imu : nullptr));
     out.back().received_ns = f.frame.received_ns;
     for (Keyframe& kf : out.back().finished_keyframes)
@@ -71,7 +71,7 @@ std::vector<estimator::WindowEstimate> EstimatorStage::process(estimator::Estima
     const estimator::WindowEstimate& e = out.back();
     if (e.status == estimator::EstimatorStatus::Tracking) {
       ++tracking;
-      const NavState s = estimator.latestState();
+      const NavState s = estimator.latest_state();
       latest.write(s);
       gyro_bias.write(s.bias_gyr);
     }
@@ -83,7 +83,7 @@ std::vector<estimator::WindowEstimate> EstimatorStage::process(estimator::Estima
 
 void EstimatorStage::finish() {
   pairer.finish();
-  std::vector<Keyframe> rest = estimator.flushKeyframes();
+  std::vector<Keyframe> rest = estimator.flush_keyframes();
   if (on_keyframe)
     for (Keyframe& kf : rest) on_keyframe(std::move(kf));
 }
@@ -106,26 +106,26 @@ namespace {
 
 // estimate_extrinsic 2 lets a config leave body_T_cam0 out; the loader then stores identity, which is no
 // calibration: a gyro rotation conjugated by it would seed the KLT in the wrong direction.
-bool gyroPredictionUsable(const VioRunOptions& o) {
+bool gyro_prediction_usable(const VioRunOptions& o) {
   const bool extrinsic_known = o.estimator.estimate_extrinsic != 2 || o.estimator.keys_from_file.count("body_T_cam0");
   if (o.gyro_prediction && !extrinsic_known)
     spdlog::warn("gyro prediction off: the config has no body_T_cam0 (estimate_extrinsic 2)");
   return o.gyro_prediction && extrinsic_known;
 }
 
-std::optional<GyroRotationPredictor> gyroPredictor(const VioRunOptions& o, bool predict) {
+std::optional<tracker::GyroRotationPredictor> gyro_predictor(const VioRunOptions& o, bool predict) {
   if (!predict) return std::nullopt;
   // Same outage threshold as the IMU stage's interval builder.
-  const ImuStageOptions imu = ImuStageOptions::from(o.estimator, o.imu_rate_hz, o.imu_noise);
-  return GyroRotationPredictor(o.estimator.body_T_cam.at(0), std::llround(imu.gap_periods * 1e9 / imu.imu_rate_hz));
+  const imu::ImuStageOptions imu = imu::ImuStageOptions::from(o.estimator, o.imu_rate_hz, o.imu_noise);
+  return tracker::GyroRotationPredictor(o.estimator.body_T_cam.at(0), std::llround(imu.gap_periods * 1e9 / imu.imu_rate_hz));
 }
 
 // As fast as possible (rate 0) the run must not depend on how fast or loaded the machine is, so each
 // window solve is bounded by its iteration budget alone; the config's wall-clock budget
 // (max_solver_time) applies to paced runs, where the estimator must keep up.
-EstimatorOptions estimatorOptions(const VioRunOptions& o) {
+EstimatorOptions estimator_options(const VioRunOptions& o) {
   EstimatorOptions e = o.estimator;
-  if (!o.realTime()) e.max_solver_time = std::numeric_limits<double>::infinity();
+  if (!o.real_time()) e.max_solver_time = std::numeric_limits<double>::infinity();
   return e;
 }
 
@@ -133,14 +133,14 @@ EstimatorOptions estimatorOptions(const VioRunOptions& o) {
 
 VioStages::VioStages(const VioRunOptions& o, std::function<void(const TrackedFrame&)> on_tracked,
                      std::function<void(const estimator::WindowEstimate&)> on_estimate)
-    : predict(gyroPredictionUsable(o)),
-      solver_time_budget(o.realTime()),
-      tracker(StereoTracker(TrackerOptions::from(o.estimator), o.estimator.cameras.at(0),
+    : predict(gyro_prediction_usable(o)),
+      solver_time_budget(o.real_time()),
+      tracker(tracker::StereoTracker(tracker::TrackerOptions::from(o.estimator), o.estimator.cameras.at(0),
                             o.mode.stereo ? o.estimator.cameras.at(1) : nullptr),
-              !o.mode.stereo, gyroPredictor(o, predict), gyro_bias, std::move(on_tracked)),
-      imu{ImuStage(ImuStageOptions::from(o.estimator, o.imu_rate_hz, o.imu_noise)), latest, {},
-          ImuPropagator(ImuPropagatorOptions{o.estimator.g_norm})},
-      estimator{FrameImuPairer{}, estimator::SlidingWindowEstimator(estimatorOptions(o), o.mode), latest, gyro_bias},
+              !o.mode.stereo, gyro_predictor(o, predict), gyro_bias, std::move(on_tracked)),
+      imu{imu::ImuStage(imu::ImuStageOptions::from(o.estimator, o.imu_rate_hz, o.imu_noise)), latest, {},
+          imu::ImuPropagator(imu::ImuPropagatorOptions{o.estimator.g_norm})},
+      estimator{imu::FrameImuPairer{}, estimator::SlidingWindowEstimator(estimator_options(o), o.mode), latest, gyro_bias},
       writer{std::move(on_estimate), {}, {}, 0, 0} {
   if (o.loop_mode != loop::LoopMode::Off)
     loop = std::make_unique<LoopStage>(o.loop_mode, o.vocabulary, o.estimator.cameras.at(0));
@@ -159,7 +159,7 @@ void VioStages::collect(VioRunResult& r) const {
   r.frames_tracking = estimator.tracking;
   r.resets = estimator.resets;
   r.imu = imu.stage.stats();
-  r.imu_builder = imu.stage.builderStats();
+  r.imu_builder = imu.stage.builder_stats();
   r.pairer = estimator.pairer.stats();
   if (loop) r.loop = loop->summary();
 }

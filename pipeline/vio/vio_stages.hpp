@@ -1,7 +1,7 @@
 #pragma once
 // The stages of the visual-inertial run (DESIGN.md §2) as plain objects, each `process(input) -> output`
-// (Kimera-VIO's PipelineModule without its thread): the threaded driver (runVio) puts each on its own
-// thread, the sequential driver (runVioSequential) calls them one after the other on the caller's thread.
+// (Kimera-VIO's PipelineModule without its thread): the threaded driver (run_vio) puts each on its own
+// thread, the sequential driver (run_vio_sequential) calls them one after the other on the caller's thread.
 // Both build them here, from the same options, so the path users run is the path the tests check.
 //
 //   tracker:   StereoFrame (+ its gyro samples) -> TrackedFrame
@@ -42,15 +42,15 @@ struct VioRunResult;
 /// Tracker: the KLT front end; in mono mode the right image is ignored. With a predictor, each frame's
 /// KLT starts from the rotation its gyro samples give since the previous tracked frame.
 struct TrackerStage {
-  TrackerStage(StereoTracker t, bool mono, std::optional<GyroRotationPredictor> g,
+  TrackerStage(tracker::StereoTracker t, bool mono, std::optional<tracker::GyroRotationPredictor> g,
                LatestValue<Eigen::Vector3d>& gyro_bias,
                std::function<void(const TrackedFrame&)> on_tracked);
 
   TrackedFrame process(TrackerInput in);
 
-  StereoTracker tracker;
+  tracker::StereoTracker tracker;
   bool mono;
-  std::optional<GyroRotationPredictor> gyro;  ///< empty: prediction off
+  std::optional<tracker::GyroRotationPredictor> gyro;  ///< empty: prediction off
   /// The estimator's newest gyro bias. A LatestValue has one reader and the IMU stage reads the
   /// NavState one, so the estimator publishes the bias a second time, for this stage alone.
   LatestValue<Eigen::Vector3d>& gyro_bias;
@@ -69,12 +69,12 @@ struct TrackerStage {
 /// state: when the estimator stops tracking (reset, lost), the IMU-rate pose stops too instead of
 /// dead-reckoning on.
 struct ImuFeedbackStage {
-  std::vector<PreintegratedInterval> process(ImuStageInput in);
+  std::vector<PreintegratedInterval> process(imu::ImuStageInput in);
 
-  ImuStage stage;
+  imu::ImuStage stage;
   LatestValue<NavState>& latest;
   std::function<void(const PoseEstimate&, int64_t origin_ns)> on_imu_pose;  ///< may be empty
-  ImuPropagator propagator;
+  imu::ImuPropagator propagator;
   int64_t max_propagation_ns = 500'000'000;
   int64_t propagated_from_ns = INT64_MIN;  ///< t_ns of the state the propagator was last reset to
 };
@@ -86,7 +86,7 @@ struct EstimatorStage {
   std::vector<estimator::WindowEstimate> process(estimator::EstimatorInput in);
   void finish();
 
-  FrameImuPairer pairer;
+  imu::FrameImuPairer pairer;
   estimator::SlidingWindowEstimator estimator;
   LatestValue<NavState>& latest;
   LatestValue<Eigen::Vector3d>& gyro_bias;  ///< the same state's gyro bias, for the tracker

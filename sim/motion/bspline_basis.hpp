@@ -19,7 +19,7 @@ struct CubicBasis {
 };
 
 /// Evaluates the basis at u in [0, 1]. b = {(1-u)^3, 3u^3-6u^2+4, -3u^3+3u^2+3u+1, u^3} / 6.
-inline CubicBasis cubicBasis(double u) {
+inline CubicBasis cubic_basis(double u) {
   CubicBasis r;
   const double u2 = u * u, u3 = u2 * u, w = 1.0 - u;
   r.b = {w * w * w / 6.0, (3.0 * u3 - 6.0 * u2 + 4.0) / 6.0, (-3.0 * u3 + 3.0 * u2 + 3.0 * u + 1.0) / 6.0,
@@ -36,8 +36,8 @@ struct CumulativeBasis {
 };
 
 /// λ1 = (5 + 3u - 3u^2 + u^3)/6, λ2 = (1 + 3u + 3u^2 - 2u^3)/6, λ3 = u^3/6.
-inline CumulativeBasis cumulativeBasis(double u) {
-  const CubicBasis c = cubicBasis(u);
+inline CumulativeBasis cumulative_basis(double u) {
+  const CubicBasis c = cubic_basis(u);
   CumulativeBasis r;
   for (int j = 2; j >= 0; --j) {
     const int k = j + 1;

@@ -32,7 +32,7 @@ class BSplineR3 {
     int i;
     double u;
     knots_.locate(t, i, u);
-    const bspline::CubicBasis b = bspline::cubicBasis(u);
+    const bspline::CubicBasis b = bspline::cubic_basis(u);
     const double inv = 1.0 / knots_.dt();
     SplineR3Value r{Eigen::Vector3d::Zero(), Eigen::Vector3d::Zero(), Eigen::Vector3d::Zero(),
                     Eigen::Vector3d::Zero()};

@@ -25,7 +25,7 @@ SplineSO3Value BSplineSO3::evaluate(double t) const {
   int i;
   double u;
   knots_.locate(t, i, u);
-  const bspline::CumulativeBasis lb = bspline::cumulativeBasis(u);
+  const bspline::CumulativeBasis lb = bspline::cumulative_basis(u);
   Eigen::Matrix3d R = c_[i];
   Eigen::Vector3d w = Eigen::Vector3d::Zero();  // in units of 1/u
   Eigen::Vector3d a = Eigen::Vector3d::Zero();  // in units of 1/u^2
@@ -43,12 +43,12 @@ SplineSO3Value BSplineSO3::evaluate(double t) const {
   return {R, w * inv, a * inv * inv};
 }
 
-Eigen::Matrix3d BSplineSO3::orientationWithJacobians(double t, int& first, std::array<Eigen::Matrix3d, 4>& J) const {
+Eigen::Matrix3d BSplineSO3::orientation_with_jacobians(double t, int& first, std::array<Eigen::Matrix3d, 4>& J) const {
   int i;
   double u;
   knots_.locate(t, i, u);
   first = i;
-  const bspline::CumulativeBasis lb = bspline::cumulativeBasis(u);
+  const bspline::CumulativeBasis lb = bspline::cumulative_basis(u);
   std::array<Eigen::Matrix3d, 3> A;
   for (int j = 0; j < 3; ++j) A[j] = so3::exp(lb.l[j] * d_[i + j]);
   // Suffix products S_j = (A_{j+1} ... A_3)^T move a perturbation inserted after factor j to the right end.
@@ -62,9 +62,9 @@ Eigen::Matrix3d BSplineSO3::orientationWithJacobians(double t, int& first, std::
   for (int j = 1; j <= 3; ++j) {
     const Eigen::Vector3d& d = d_[i + j - 1];
     const double l = lb.l[j - 1];
-    const Eigen::Matrix3d E = S[j] * (l * so3::rightJacobian(l * d));
-    J[j] += E * so3::rightJacobianInverse(d);
-    J[j - 1] -= E * so3::leftJacobianInverse(d);
+    const Eigen::Matrix3d E = S[j] * (l * so3::right_jacobian(l * d));
+    J[j] += E * so3::right_jacobian_inverse(d);
+    J[j - 1] -= E * so3::left_jacobian_inverse(d);
   }
   return c_[i] * A[0] * A[1] * A[2];
 }

@@ -39,7 +39,7 @@ class BSplineSO3 {
 
   /// Orientation at t and the Jacobians of its right perturbation w.r.t. right perturbations of the four
   /// active control points: R(t; R_k Exp(δ_k)) ≈ R(t) Exp(Σ_j J[j] δ_{first+j}). For the fit.
-  Eigen::Matrix3d orientationWithJacobians(double t, int& first, std::array<Eigen::Matrix3d, 4>& J) const;
+  Eigen::Matrix3d orientation_with_jacobians(double t, int& first, std::array<Eigen::Matrix3d, 4>& J) const;
 
   /// Increment d_k = Log(R_k^T R_{k+1}) between consecutive control points (k = 0..N-2).
   const Eigen::Vector3d& increment(int k) const { return d_[k]; }

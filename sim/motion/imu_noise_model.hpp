@@ -18,7 +18,7 @@ struct ImuNoiseModel {
   Eigen::Vector3d gyr_bias_initial = Eigen::Vector3d::Zero();  ///< gyroscope bias at the first sample [rad/s]
 
   /// A model with no noise, no bias walk and zero biases (the exact IMU of the trajectory).
-  static ImuNoiseModel noiseFree() {
+  static ImuNoiseModel noise_free() {
     ImuNoiseModel m;
     m.acc_noise_density = m.gyr_noise_density = m.acc_random_walk = m.gyr_random_walk = 0.0;
     return m;

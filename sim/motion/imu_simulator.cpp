@@ -19,7 +19,7 @@ ImuSimulator::ImuSimulator(ImuSimulatorOptions options) : opt_(std::move(options
   if (period_ns_ <= 0) throw std::invalid_argument("ImuSimulator: rate too high");
 }
 
-GroundTruthState groundTruthAt(const SmoothTrajectory& traj, int64_t t_ns) {
+GroundTruthState ground_truth_at(const SmoothTrajectory& traj, int64_t t_ns) {
   const KinematicState s = traj.evaluate(static_cast<double>(t_ns) * 1e-9);
   GroundTruthState g;
   g.t_ns = t_ns;
@@ -31,7 +31,7 @@ GroundTruthState groundTruthAt(const SmoothTrajectory& traj, int64_t t_ns) {
   return g;
 }
 
-ImuSample ImuSimulator::idealSample(const SmoothTrajectory& traj, double t) const {
+ImuSample ImuSimulator::ideal_sample(const SmoothTrajectory& traj, double t) const {
   const KinematicState s = traj.evaluate(t);
   const Eigen::Vector3d g_w(0.0, 0.0, -opt_.gravity);
   ImuSample m;
@@ -41,12 +41,12 @@ ImuSample ImuSimulator::idealSample(const SmoothTrajectory& traj, double t) cons
 }
 
 ImuSimulation ImuSimulator::simulate(const SmoothTrajectory& traj) const {
-  // First/last whole multiples of the period inside [tMin, tMax]. With absolute (epoch) times a double
+  // First/last whole multiples of the period inside [t_min, t_max]. With absolute (epoch) times a double
   // resolves only ~0.2 us, so step inwards until the sample times really evaluate inside the range.
-  auto first = static_cast<int64_t>(std::ceil(traj.tMin() * 1e9 / period_ns_));
-  auto last = static_cast<int64_t>(std::floor(traj.tMax() * 1e9 / period_ns_));
-  while (static_cast<double>(first * period_ns_) * 1e-9 < traj.tMin() - 1e-9) ++first;
-  while (static_cast<double>(last * period_ns_) * 1e-9 > traj.tMax() + 1e-9) --last;
+  auto first = static_cast<int64_t>(std::ceil(traj.t_min() * 1e9 / period_ns_));
+  auto last = static_cast<int64_t>(std::floor(traj.t_max() * 1e9 / period_ns_));
+  while (static_cast<double>(first * period_ns_) * 1e-9 < traj.t_min() - 1e-9) ++first;
+  while (static_cast<double>(last * period_ns_) * 1e-9 > traj.t_max() + 1e-9) --last;
   if (last < first) throw std::invalid_argument("ImuSimulator::simulate: trajectory shorter than one period");
   return simulate(traj, first * period_ns_, last * period_ns_);
 }

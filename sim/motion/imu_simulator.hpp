@@ -33,7 +33,7 @@ struct ImuSimulation {
 
 /// Ground truth of `traj` at t_ns (evaluated at t = t_ns * 1e-9 s): pose and velocity, no biases
 /// (has_velocity = true, has_biases = false). For camera-rate ground truth.
-GroundTruthState groundTruthAt(const SmoothTrajectory& traj, int64_t t_ns);
+GroundTruthState ground_truth_at(const SmoothTrajectory& traj, int64_t t_ns);
 
 /// Generates IMU samples along a trajectory.
 class ImuSimulator {
@@ -43,12 +43,12 @@ class ImuSimulator {
   /// The settings in use.
   const ImuSimulatorOptions& options() const { return opt_; }
   /// Sample period [ns].
-  int64_t periodNs() const { return period_ns_; }
+  int64_t period_ns() const { return period_ns_; }
 
   /// Noise-free specific force and angular rate of `traj` at time t [s] (t_ns left 0).
-  ImuSample idealSample(const SmoothTrajectory& traj, double t) const;
+  ImuSample ideal_sample(const SmoothTrajectory& traj, double t) const;
 
-  /// Samples at the multiples of the period within [traj.tMin(), traj.tMax()]. Trajectories on epoch time
+  /// Samples at the multiples of the period within [traj.t_min(), traj.t_max()]. Trajectories on epoch time
   /// (TumFitOptions::shift_to_zero = false) work but are evaluated to ~0.2 us only; prefer time from 0.
   ImuSimulation simulate(const SmoothTrajectory& traj) const;
   /// Samples at t_begin_ns + k * period while <= t_end_ns; the range must lie inside the trajectory.

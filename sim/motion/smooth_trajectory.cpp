@@ -8,7 +8,7 @@ SmoothTrajectory::SmoothTrajectory(BSplineR3 position, BSplineSO3 orientation)
     : pos_(std::move(position)), rot_(std::move(orientation)) {
   const UniformKnots& a = pos_.knots();
   const UniformKnots& b = rot_.knots();
-  if (a.numControl() != b.numControl() || a.t0() != b.t0() || a.dt() != b.dt())
+  if (a.num_control() != b.num_control() || a.t0() != b.t0() || a.dt() != b.dt())
     throw std::invalid_argument("SmoothTrajectory: position and orientation splines must share one knot grid");
 }
 
@@ -34,7 +34,7 @@ Eigen::Isometry3d SmoothTrajectory::pose(double t) const {
   return T;
 }
 
-SmoothTrajectory SmoothTrajectory::shiftedInTime(double offset) const {
+SmoothTrajectory SmoothTrajectory::shifted_in_time(double offset) const {
   const UniformKnots& k = pos_.knots();
   return SmoothTrajectory(BSplineR3(k.t0() + offset, k.dt(), pos_.control()),
                           BSplineSO3(k.t0() + offset, k.dt(), rot_.control()));

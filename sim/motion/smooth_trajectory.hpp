@@ -38,14 +38,14 @@ class SmoothTrajectory {
   SmoothTrajectory(BSplineR3 position, BSplineSO3 orientation);
 
   /// Start / end of the valid time range [s].
-  double tMin() const { return pos_.knots().tMin(); }
-  double tMax() const { return pos_.knots().tMax(); }
-  /// Duration tMax - tMin [s].
-  double duration() const { return tMax() - tMin(); }
+  double t_min() const { return pos_.knots().t_min(); }
+  double t_max() const { return pos_.knots().t_max(); }
+  /// Duration t_max - t_min [s].
+  double duration() const { return t_max() - t_min(); }
   /// Knot spacing [s].
-  double knotSpacing() const { return pos_.knots().dt(); }
+  double knot_spacing() const { return pos_.knots().dt(); }
 
-  /// Everything at time t (throws std::out_of_range outside [tMin, tMax]).
+  /// Everything at time t (throws std::out_of_range outside [t_min, t_max]).
   KinematicState evaluate(double t) const;
   /// Position p_wb(t) [m].
   Eigen::Vector3d position(double t) const { return pos_.evaluate(t).p; }
@@ -58,14 +58,14 @@ class SmoothTrajectory {
   /// Orientation q_wb(t).
   Eigen::Quaterniond orientation(double t) const { return Eigen::Quaterniond(rotation(t)); }
   /// Body angular velocity ω_b(t) [rad/s].
-  Eigen::Vector3d angularVelocity(double t) const { return rot_.evaluate(t).omega; }
+  Eigen::Vector3d angular_velocity(double t) const { return rot_.evaluate(t).omega; }
   /// Pose T_world_body(t).
   Eigen::Isometry3d pose(double t) const;
   /// The same motion with time shifted: the new trajectory at t + offset equals this one at t.
-  SmoothTrajectory shiftedInTime(double offset) const;
+  SmoothTrajectory shifted_in_time(double offset) const;
 
-  const BSplineR3& positionSpline() const { return pos_; }        ///< the position spline
-  const BSplineSO3& orientationSpline() const { return rot_; }  ///< the orientation spline
+  const BSplineR3& position_spline() const { return pos_; }        ///< the position spline
+  const BSplineSO3& orientation_spline() const { return rot_; }  ///< the orientation spline
 
  private:
   BSplineR3 pos_;

@@ -53,10 +53,10 @@ class BandedNormalEquations {
     Eigen::SparseMatrix<double> H(static_cast<Eigen::Index>(n_) * B, static_cast<Eigen::Index>(n_) * B);
     H.setFromTriplets(trip.begin(), trip.end());
     Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>> ldlt(H);
-    if (ldlt.info() != Eigen::Success) throw std::runtime_error("fitTrajectory: normal equations are singular");
+    if (ldlt.info() != Eigen::Success) throw std::runtime_error("fit_trajectory: normal equations are singular");
     Eigen::MatrixXd x = ldlt.solve(rhs);
     if (ldlt.info() != Eigen::Success || !x.allFinite())
-      throw std::runtime_error("fitTrajectory: solving the normal equations failed");
+      throw std::runtime_error("fit_trajectory: solving the normal equations failed");
     return x;
   }
   const Eigen::VectorXd& gradient() const { return g_; }
@@ -68,10 +68,10 @@ class BandedNormalEquations {
 };
 
 void validate(const std::vector<TimedPose>& poses) {
-  if (poses.size() < 2) throw std::invalid_argument("fitTrajectory: need at least 2 poses, got " + std::to_string(poses.size()));
+  if (poses.size() < 2) throw std::invalid_argument("fit_trajectory: need at least 2 poses, got " + std::to_string(poses.size()));
   for (size_t m = 0; m < poses.size(); ++m) {
     const TimedPose& s = poses[m];
-    const std::string where = "fitTrajectory: pose " + std::to_string(m) + " (t=" + std::to_string(s.t) + "): ";
+    const std::string where = "fit_trajectory: pose " + std::to_string(m) + " (t=" + std::to_string(s.t) + "): ";
     if (!std::isfinite(s.t) || !s.p.allFinite() || !s.q.coeffs().allFinite())
       throw std::invalid_argument(where + "non-finite value");
     if (std::abs(s.q.norm() - 1.0) > 1e-3) throw std::invalid_argument(where + "quaternion is not unit");
@@ -85,7 +85,7 @@ void validate(const std::vector<TimedPose>& poses) {
 }
 
 // Orientation of the data at time t by slerp between the bracketing samples (clamped at the ends).
-Eigen::Quaterniond interpolateOrientation(const std::vector<TimedPose>& poses, double t) {
+Eigen::Quaterniond interpolate_orientation(const std::vector<TimedPose>& poses, double t) {
   if (t <= poses.front().t) return poses.front().q.normalized();
   if (t >= poses.back().t) return poses.back().q.normalized();
   const auto it = std::upper_bound(poses.begin(), poses.end(), t, [](double x, const TimedPose& s) { return x < s.t; });
@@ -94,9 +94,9 @@ Eigen::Quaterniond interpolateOrientation(const std::vector<TimedPose>& poses, d
   return a.q.normalized().slerp((t - a.t) / (b.t - a.t), b.q.normalized());
 }
 
-std::vector<Eigen::Vector3d> fitPositions(const std::vector<TimedPose>& poses, const UniformKnots& knots,
+std::vector<Eigen::Vector3d> fit_positions(const std::vector<TimedPose>& poses, const UniformKnots& knots,
                                           const TrajectoryFitOptions& o) {
-  const int n = knots.numControl();
+  const int n = knots.num_control();
   BandedNormalEquations<1> ne(n);
   Eigen::MatrixXd rhs = Eigen::MatrixXd::Zero(n, 3);
   const double w_data = 1.0 / (o.position_sigma * o.position_sigma);
@@ -105,7 +105,7 @@ std::vector<Eigen::Vector3d> fitPositions(const std::vector<TimedPose>& poses, c
     int i;
     double u;
     knots.locate(s.t, i, u);
-    const bspline::CubicBasis b = bspline::cubicBasis(u);
+    const bspline::CubicBasis b = bspline::cubic_basis(u);
     for (int k = 0; k < 4; ++k) {
       J[k](0, 0) = b.b[k];
       rhs.row(i + k) += w_data * b.b[k] * s.p.transpose();
@@ -127,23 +127,23 @@ std::vector<Eigen::Vector3d> fitPositions(const std::vector<TimedPose>& poses, c
   return c;
 }
 
-Eigen::Vector3d angularJerkResidual(const BSplineSO3& s, int i) {
+Eigen::Vector3d angular_jerk_residual(const BSplineSO3& s, int i) {
   return s.increment(i) - 2.0 * s.increment(i + 1) + s.increment(i + 2);
 }
 
 // Gauss-Newton step for the orientation control points; returns the cost before the step in `cost`.
-Eigen::VectorXd rotationStep(const std::vector<TimedPose>& poses, const BSplineSO3& spline, double w_data,
+Eigen::VectorXd rotation_step(const std::vector<TimedPose>& poses, const BSplineSO3& spline, double w_data,
                              double w_reg, double& cost) {
-  const int n = spline.knots().numControl();
+  const int n = spline.knots().num_control();
   BandedNormalEquations<3> ne(n);
   cost = 0.0;
   std::array<Eigen::Matrix3d, 4> Jc;
   std::vector<Eigen::Matrix3d> J(4);
   for (const TimedPose& s : poses) {
     int first;
-    const Eigen::Matrix3d R = spline.orientationWithJacobians(s.t, first, Jc);
+    const Eigen::Matrix3d R = spline.orientation_with_jacobians(s.t, first, Jc);
     const Eigen::Vector3d r = so3::log(s.q.toRotationMatrix().transpose() * R);
-    const Eigen::Matrix3d Jri = so3::rightJacobianInverse(r);
+    const Eigen::Matrix3d Jri = so3::right_jacobian_inverse(r);
     for (int k = 0; k < 4; ++k) J[k] = Jri * Jc[k];
     ne.add<3>(first, J, r, w_data);
     cost += w_data * r.squaredNorm();
@@ -155,27 +155,27 @@ Eigen::VectorXd rotationStep(const std::vector<TimedPose>& poses, const BSplineS
     const Eigen::Vector3d& d0 = spline.increment(i);
     const Eigen::Vector3d& d1 = spline.increment(i + 1);
     const Eigen::Vector3d& d2 = spline.increment(i + 2);
-    const Eigen::Vector3d e = angularJerkResidual(spline, i);
-    D[0] = -so3::leftJacobianInverse(d0);
-    D[1] = so3::rightJacobianInverse(d0) + 2.0 * so3::leftJacobianInverse(d1);
-    D[2] = -2.0 * so3::rightJacobianInverse(d1) - so3::leftJacobianInverse(d2);
-    D[3] = so3::rightJacobianInverse(d2);
+    const Eigen::Vector3d e = angular_jerk_residual(spline, i);
+    D[0] = -so3::left_jacobian_inverse(d0);
+    D[1] = so3::right_jacobian_inverse(d0) + 2.0 * so3::left_jacobian_inverse(d1);
+    D[2] = -2.0 * so3::right_jacobian_inverse(d1) - so3::left_jacobian_inverse(d2);
+    D[3] = so3::right_jacobian_inverse(d2);
     ne.add<3>(i, D, e, w_reg);
     cost += w_reg * e.squaredNorm();
   }
   return -ne.solve(ne.gradient());
 }
 
-double rotationCost(const std::vector<TimedPose>& poses, const BSplineSO3& spline, double w_data, double w_reg) {
+double rotation_cost(const std::vector<TimedPose>& poses, const BSplineSO3& spline, double w_data, double w_reg) {
   double cost = 0.0;
   for (const TimedPose& s : poses)
     cost += w_data * so3::log(s.q.toRotationMatrix().transpose() * spline.evaluate(s.t).R).squaredNorm();
-  const int n = spline.knots().numControl();
-  for (int i = 0; i + 3 < n; ++i) cost += w_reg * angularJerkResidual(spline, i).squaredNorm();
+  const int n = spline.knots().num_control();
+  for (int i = 0; i + 3 < n; ++i) cost += w_reg * angular_jerk_residual(spline, i).squaredNorm();
   return cost;
 }
 
-std::vector<Eigen::Matrix3d> applyStep(const std::vector<Eigen::Matrix3d>& c, const Eigen::VectorXd& dx, double scale) {
+std::vector<Eigen::Matrix3d> apply_step(const std::vector<Eigen::Matrix3d>& c, const Eigen::VectorXd& dx, double scale) {
   std::vector<Eigen::Matrix3d> out(c.size());
   for (size_t k = 0; k < c.size(); ++k) {
     const Eigen::Matrix3d R = c[k] * so3::exp(scale * dx.segment<3>(static_cast<Eigen::Index>(3 * k)));
@@ -186,23 +186,23 @@ std::vector<Eigen::Matrix3d> applyStep(const std::vector<Eigen::Matrix3d>& c, co
 
 }  // namespace
 
-SmoothTrajectory fitTrajectory(const std::vector<TimedPose>& poses, const TrajectoryFitOptions& o,
+SmoothTrajectory fit_trajectory(const std::vector<TimedPose>& poses, const TrajectoryFitOptions& o,
                                TrajectoryFitReport* report) {
   validate(poses);
   if (!(o.knot_spacing > 0.0) || !(o.position_sigma > 0.0) || !(o.rotation_sigma > 0.0) || !(o.jerk_psd > 0.0) ||
       !(o.angular_jerk_psd > 0.0))
-    throw std::invalid_argument("fitTrajectory: knot spacing, sigmas and PSDs must be > 0");
+    throw std::invalid_argument("fit_trajectory: knot spacing, sigmas and PSDs must be > 0");
   const double t0 = poses.front().t;
   const double span = poses.back().t - t0;
   const int segments = std::max(1, static_cast<int>(std::ceil(span / o.knot_spacing - 1e-9)));
   const double dt = span / segments;
   const UniformKnots knots(t0, dt, segments + 3);
-  const int n = knots.numControl();
+  const int n = knots.num_control();
 
-  BSplineR3 pos(t0, dt, fitPositions(poses, knots, o));
+  BSplineR3 pos(t0, dt, fit_positions(poses, knots, o));
 
   std::vector<Eigen::Matrix3d> rc(n);
-  for (int k = 0; k < n; ++k) rc[k] = interpolateOrientation(poses, knots.controlTime(k)).toRotationMatrix();
+  for (int k = 0; k < n; ++k) rc[k] = interpolate_orientation(poses, knots.control_time(k)).toRotationMatrix();
   BSplineSO3 rot(t0, dt, rc);
   const double w_data = 1.0 / (o.rotation_sigma * o.rotation_sigma);
   const double w_reg = 1.0 / (o.angular_jerk_psd * std::pow(dt, 5));
@@ -210,13 +210,13 @@ SmoothTrajectory fitTrajectory(const std::vector<TimedPose>& poses, const Trajec
   bool converged = false;
   for (; iterations < o.max_iterations && !converged; ++iterations) {
     double cost;
-    const Eigen::VectorXd dx = rotationStep(poses, rot, w_data, w_reg, cost);
+    const Eigen::VectorXd dx = rotation_step(poses, rot, w_data, w_reg, cost);
     // Backtracking keeps Gauss-Newton monotone if the linearisation is poor far from the optimum.
     double scale = 1.0;
     for (int ls = 0; ls < 10; ++ls, scale *= 0.5) {
-      std::vector<Eigen::Matrix3d> trial = applyStep(rc, dx, scale);
+      std::vector<Eigen::Matrix3d> trial = apply_step(rc, dx, scale);
       BSplineSO3 trial_spline(t0, dt, trial);
-      const double new_cost = rotationCost(poses, trial_spline, w_data, w_reg);
+      const double new_cost = rotation_cost(poses, trial_spline, w_data, w_reg);
       if (new_cost <= cost || ls == 9) {
         rc = std::move(trial);
         rot = std::move(trial_spline);

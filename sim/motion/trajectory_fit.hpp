@@ -61,7 +61,7 @@ struct TrajectoryFitReport {
 /// Fits a SmoothTrajectory spanning exactly [poses.front().t, poses.back().t].
 /// Needs >= 2 poses with strictly increasing, finite times and unit quaternions, and consecutive
 /// orientations less than pi apart (throws std::invalid_argument naming the offending index otherwise).
-SmoothTrajectory fitTrajectory(const std::vector<TimedPose>& poses, const TrajectoryFitOptions& options = {},
+SmoothTrajectory fit_trajectory(const std::vector<TimedPose>& poses, const TrajectoryFitOptions& options = {},
                                TrajectoryFitReport* report = nullptr);
 
 }  // namespace dynavins::sim

@@ -10,7 +10,7 @@
 
 namespace dynavins::sim {
 
-std::vector<TimedPose> readTumTrajectory(const std::string& path) {
+std::vector<TimedPose> read_tum_trajectory(const std::string& path) {
   // One TUM reader in the project (eval/): plain or gzip, every bad row named by file and line.
   const eval::Trajectory traj = eval::read_trajectory(path, eval::TrajectoryFormat::Tum);
   if (traj.empty()) throw std::runtime_error(path + ": no poses in trajectory file");
@@ -20,20 +20,20 @@ std::vector<TimedPose> readTumTrajectory(const std::string& path) {
   return out;
 }
 
-std::vector<TimedPose> selectWindow(const std::vector<TimedPose>& poses, double window_start, double window_duration) {
-  if (poses.empty()) throw std::invalid_argument("selectWindow: empty pose list");
+std::vector<TimedPose> select_window(const std::vector<TimedPose>& poses, double window_start, double window_duration) {
+  if (poses.empty()) throw std::invalid_argument("select_window: empty pose list");
   const double a = poses.front().t + window_start;
   const double b = window_duration > 0.0 ? a + window_duration : poses.back().t;
   std::vector<TimedPose> out;
   for (const TimedPose& s : poses)
     if (s.t >= a && s.t <= b) out.push_back(s);
   if (out.size() < 2)
-    throw std::invalid_argument("selectWindow: window [" + std::to_string(window_start) + " s, +" +
+    throw std::invalid_argument("select_window: window [" + std::to_string(window_start) + " s, +" +
                                 std::to_string(window_duration) + " s] holds fewer than 2 poses");
   return out;
 }
 
-int removePositionJumps(std::vector<TimedPose>& poses, double glitch_acceleration, double min_jump) {
+int remove_position_jumps(std::vector<TimedPose>& poses, double glitch_acceleration, double min_jump) {
   if (glitch_acceleration <= 0.0 || poses.size() < 4) return 0;
   const int n = static_cast<int>(poses.size());
   auto stepVelocity = [&](int j) { return Eigen::Vector3d((poses[j].p - poses[j - 1].p) / (poses[j].t - poses[j - 1].t)); };
@@ -69,9 +69,9 @@ int removePositionJumps(std::vector<TimedPose>& poses, double glitch_acceleratio
   return removed;
 }
 
-SmoothTrajectory fitTumTrajectory(const std::string& path, const TumFitOptions& o, TumFitReport* report) {
-  std::vector<TimedPose> poses = selectWindow(readTumTrajectory(path), o.window_start, o.window_duration);
-  const int removed = removePositionJumps(poses, o.glitch_acceleration);
+SmoothTrajectory fit_tum_trajectory(const std::string& path, const TumFitOptions& o, TumFitReport* report) {
+  std::vector<TimedPose> poses = select_window(read_tum_trajectory(path), o.window_start, o.window_duration);
+  const int removed = remove_position_jumps(poses, o.glitch_acceleration);
   if (removed > 0) spdlog::info("{}: removed {} position glitch(es) before fitting", path, removed);
   const double offset = o.shift_to_zero ? poses.front().t : 0.0;
   const Eigen::Quaterniond q_world(o.world_from_file.linear()), q_body(o.file_body_from_body);
@@ -81,7 +81,7 @@ SmoothTrajectory fitTumTrajectory(const std::string& path, const TumFitOptions& 
     s.q = (q_world * s.q * q_body).normalized();
   }
   TrajectoryFitReport fr;
-  SmoothTrajectory traj = fitTrajectory(poses, o.fit, &fr);
+  SmoothTrajectory traj = fit_trajectory(poses, o.fit, &fr);
   if (report) {
     report->fit = fr;
     report->time_offset = offset;

@@ -14,7 +14,7 @@ namespace dynavins::sim {
 /// Blank lines and lines starting with '#' are skipped. Throws std::runtime_error naming the file and the
 /// line for: unreadable file, a row without exactly 8 numbers, a non-finite value, a non-unit quaternion
 /// (|q| off by > 1e-3), or a time not strictly after the previous one. Quaternions are returned normalised.
-std::vector<TimedPose> readTumTrajectory(const std::string& path);
+std::vector<TimedPose> read_tum_trajectory(const std::string& path);
 
 /// Which part of a TUM file to use and how to fit it.
 struct TumFitOptions {
@@ -23,7 +23,7 @@ struct TumFitOptions {
   bool shift_to_zero = true;     ///< make time 0 the first pose of the window (else keep file time)
   /// Position steps whose excess over the local motion implies more than this acceleration [m/s^2] are
   /// ground-truth glitches (EuRoC MH_03/04/05 have steps of 0.4-13 cm when the laser tracker re-locks) and
-  /// are removed by shifting the later samples; <= 0 disables. See removePositionJumps.
+  /// are removed by shifting the later samples; <= 0 disables. See remove_position_jumps.
   double glitch_acceleration = 50.0;
   TrajectoryFitOptions fit;      ///< spline fit settings
   /// Rigid placement applied to every sample before the fit: p' = world_from_file * p and
@@ -33,7 +33,7 @@ struct TumFitOptions {
   Eigen::Matrix3d file_body_from_body = Eigen::Matrix3d::Identity();
 };
 
-/// What fitTumTrajectory did.
+/// What fit_tum_trajectory did.
 struct TumFitReport {
   TrajectoryFitReport fit;   ///< residuals are against the (de-glitched) samples of the window
   double time_offset = 0.0;  ///< file time of trajectory time 0 [s] (0 if shift_to_zero is false)
@@ -42,7 +42,7 @@ struct TumFitReport {
 
 /// Selects the samples of a window of a pose list (times as in the list). Throws std::invalid_argument if
 /// the window holds fewer than 2 poses.
-std::vector<TimedPose> selectWindow(const std::vector<TimedPose>& poses, double window_start, double window_duration);
+std::vector<TimedPose> select_window(const std::vector<TimedPose>& poses, double window_start, double window_duration);
 
 /// Removes isolated position steps: a step p_m - p_{m-1} is compared with the per-axis median velocity of
 /// the three steps before and after it times the step's duration dt. Smooth motion leaves an excess of
@@ -50,10 +50,10 @@ std::vector<TimedPose> selectWindow(const std::vector<TimedPose>& poses, double 
 /// is subtracted from p_m and all later samples. A single outlier sample is thus removed too (its return
 /// step cancels the shift). Steps longer than 1.5 times the median interval (dropouts) are left alone.
 /// Returns how many steps were corrected; glitch_acceleration <= 0 disables.
-int removePositionJumps(std::vector<TimedPose>& poses, double glitch_acceleration, double min_jump = 1e-3);
+int remove_position_jumps(std::vector<TimedPose>& poses, double glitch_acceleration, double min_jump = 1e-3);
 
 /// Reads `path`, takes the window, removes glitches, optionally shifts time, and fits the spline.
-SmoothTrajectory fitTumTrajectory(const std::string& path, const TumFitOptions& options = {},
+SmoothTrajectory fit_tum_trajectory(const std::string& path, const TumFitOptions& options = {},
                                   TumFitReport* report = nullptr);
 
 }  // namespace dynavins::sim

@@ -24,22 +24,22 @@ class UniformKnots {
 
   double t0() const { return t0_; }                                ///< start of the valid range [s]
   double dt() const { return dt_; }                                ///< knot spacing [s]
-  int numControl() const { return n_; }                            ///< number of control points
-  int numSegments() const { return n_ - 3; }                       ///< number of polynomial pieces
-  double tMin() const { return t0_; }                              ///< first valid time [s]
-  double tMax() const { return t0_ + dt_ * numSegments(); }        ///< last valid time [s]
+  int num_control() const { return n_; }                            ///< number of control points
+  int num_segments() const { return n_ - 3; }                       ///< number of polynomial pieces
+  double t_min() const { return t0_; }                              ///< first valid time [s]
+  double t_max() const { return t0_ + dt_ * num_segments(); }        ///< last valid time [s]
   /// Time at which control point k has its peak basis weight.
-  double controlTime(int k) const { return t0_ + dt_ * (k - 1); }
+  double control_time(int k) const { return t0_ + dt_ * (k - 1); }
 
-  /// Segment index and normalised time u in [0, 1] of time t; throws outside [tMin, tMax] (with a
+  /// Segment index and normalised time u in [0, 1] of time t; throws outside [t_min, t_max] (with a
   /// tolerance of 1e-9 s so that times rounded through nanoseconds at the ends still evaluate).
   void locate(double t, int& segment, double& u) const {
     const double s = (t - t0_) / dt_;
     const double tol = 1e-9 / dt_;
-    if (!(s >= -tol && s <= numSegments() + tol))
+    if (!(s >= -tol && s <= num_segments() + tol))
       throw std::out_of_range("spline evaluated at t=" + std::to_string(t) + " s outside [" +
-                              std::to_string(tMin()) + ", " + std::to_string(tMax()) + "]");
-    segment = std::clamp(static_cast<int>(std::floor(s)), 0, numSegments() - 1);
+                              std::to_string(t_min()) + ", " + std::to_string(t_max()) + "]");
+    segment = std::clamp(static_cast<int>(std::floor(s)), 0, num_segments() - 1);
     u = std::clamp(s - segment, 0.0, 1.0);
   }
 

@@ -13,9 +13,9 @@ namespace {
 
 constexpr double kPi = 3.14159265358979323846;
 
-double wrapAngle(double a) { return std::remainder(a, 2.0 * kPi); }  // to [-pi, pi]
+double wrap_angle(double a) { return std::remainder(a, 2.0 * kPi); }  // to [-pi, pi]
 
-std::invalid_argument pathError(const std::string& what) { return std::invalid_argument("path: " + what); }
+std::invalid_argument path_error(const std::string& what) { return std::invalid_argument("path: " + what); }
 
 // A straight line or a circular arc of the rounded path, parametrised by arc length s in [0, length].
 struct Piece {
@@ -59,7 +59,7 @@ struct Move {
     const size_t k = it == piece_start.begin() ? 0 : static_cast<size_t>(it - piece_start.begin()) - 1;
     return pieces[k].tangent(std::clamp(s - piece_start[k], 0.0, pieces[k].length));
   }
-  double speedLimit(double s, const PathProfile& prof) const {
+  double speed_limit(double s, const PathProfile& prof) const {
     const auto it = std::upper_bound(piece_start.begin(), piece_start.end(), s);
     const size_t k = it == piece_start.begin() ? 0 : static_cast<size_t>(it - piece_start.begin()) - 1;
     double lim = prof.cruise_speed;
@@ -92,36 +92,36 @@ double smoothstep5(double x) {
 }
 
 void validate(const std::vector<PathWaypoint>& w, const PathProfile& p) {
-  if (w.size() < 2) throw pathError("need at least 2 waypoints, got " + std::to_string(w.size()));
+  if (w.size() < 2) throw path_error("need at least 2 waypoints, got " + std::to_string(w.size()));
   for (size_t i = 0; i < w.size(); ++i) {
     const std::string at = "waypoint " + std::to_string(i) + ": ";
     if (!w[i].p.allFinite() || !std::isfinite(w[i].pitch) || !std::isfinite(w[i].roll) ||
         (w[i].yaw && !std::isfinite(*w[i].yaw)) || !std::isfinite(w[i].dwell) || w[i].dwell < 0.0)
-      throw pathError(at + "non-finite value or negative dwell");
-    if (p.heading == HeadingMode::kWaypoints && !w[i].yaw) throw pathError(at + "yaw required by HeadingMode::kWaypoints");
+      throw path_error(at + "non-finite value or negative dwell");
+    if (p.heading == HeadingMode::kWaypoints && !w[i].yaw) throw path_error(at + "yaw required by HeadingMode::kWaypoints");
     if (i > 0 && (w[i].p - w[i - 1].p).norm() < 1e-6)
-      throw pathError(at + "coincides with the previous waypoint (use dwell to wait)");
+      throw path_error(at + "coincides with the previous waypoint (use dwell to wait)");
   }
   auto pos = [](double x) { return x > 0.0 && std::isfinite(x); };
   if (!pos(p.cruise_speed) || !pos(p.max_lateral_acc) || !pos(p.max_longitudinal_acc) || !pos(p.corner_radius) ||
       !pos(p.max_yaw_rate) || !pos(p.sample_dt) || !(p.max_corner_angle > 0.0 && p.max_corner_angle <= kPi) ||
       !(p.start_dwell >= 0.0) || !(p.end_dwell >= 0.0) || !std::isfinite(p.yaw_offset) ||
       !(p.smoothing_time >= 0.0) || !std::isfinite(p.smoothing_time))
-    throw pathError("profile limits must be > 0 (dwells and smoothing >= 0, max_corner_angle in (0, pi])");
+    throw path_error("profile limits must be > 0 (dwells and smoothing >= 0, max_corner_angle in (0, pi])");
 }
 
 // Orientation of each waypoint's scripted angles, with yaws unwrapped along the list (shortest turn).
-std::vector<double> unwrappedWaypointYaws(const std::vector<PathWaypoint>& w) {
+std::vector<double> unwrapped_waypoint_yaws(const std::vector<PathWaypoint>& w) {
   std::vector<double> y(w.size(), 0.0);
   for (size_t i = 0; i < w.size(); ++i) {
     const double raw = w[i].yaw.value_or(0.0);
-    y[i] = i == 0 ? raw : y[i - 1] + wrapAngle(raw - y[i - 1]);
+    y[i] = i == 0 ? raw : y[i - 1] + wrap_angle(raw - y[i - 1]);
   }
   return y;
 }
 
 // Linear interpolation of per-waypoint values along the move's arc length.
-double interpolateAlong(const Move& m, const std::vector<double>& values, double s) {
+double interpolate_along(const Move& m, const std::vector<double>& values, double s) {
   const auto& wp = m.wp;
   if (s <= wp.front().first) return values[wp.front().second];
   for (size_t k = 1; k < wp.size(); ++k)
@@ -133,7 +133,7 @@ double interpolateAlong(const Move& m, const std::vector<double>& values, double
 }
 
 // Builds the rounded geometry of the waypoints a..b (a and b are stops, the ones between are rounded).
-Move buildMove(const std::vector<PathWaypoint>& w, int a, int b, const PathProfile& prof) {
+Move build_move(const std::vector<PathWaypoint>& w, int a, int b, const PathProfile& prof) {
   // Tangent length and arc of each interior corner.
   const int n = b - a + 1;
   std::vector<double> tl(n, 0.0);
@@ -185,7 +185,7 @@ Move buildMove(const std::vector<PathWaypoint>& w, int a, int b, const PathProfi
 
 // Speed profile on a grid: limits (cruise, lateral acceleration on arcs, rotation rate), then a forward
 // pass (speeding up) and a backward pass (braking) at the longitudinal limit, rest at both ends.
-void profileMove(Move& m, const PathProfile& prof, const std::vector<double>& pitch, const std::vector<double>& roll,
+void profile_move(Move& m, const PathProfile& prof, const std::vector<double>& pitch, const std::vector<double>& roll,
                  const std::vector<double>& wp_yaw, double& last_yaw) {
   const int segs = std::max(20, static_cast<int>(std::ceil(m.length / 0.005)));
   const int nn = segs + 1;
@@ -203,26 +203,26 @@ void profileMove(Move& m, const PathProfile& prof, const std::vector<double>& pi
         carry = yaw[j];
         break;
       }
-    carry = last_yaw + wrapAngle(carry - last_yaw);
+    carry = last_yaw + wrap_angle(carry - last_yaw);
     for (int j = 0; j < nn; ++j) {
       if (std::isnan(yaw[j])) {
         yaw[j] = carry;
       } else {
-        yaw[j] = carry + wrapAngle(yaw[j] - carry);
+        yaw[j] = carry + wrap_angle(yaw[j] - carry);
         carry = yaw[j];
       }
     }
   } else {
-    for (int j = 0; j < nn; ++j) yaw[j] = interpolateAlong(m, wp_yaw, j * m.ds);
+    for (int j = 0; j < nn; ++j) yaw[j] = interpolate_along(m, wp_yaw, j * m.ds);
   }
   last_yaw = yaw.back();
   m.R.resize(nn);
   for (int j = 0; j < nn; ++j) {
     const double s = j * m.ds;
-    m.R[j] = so3::fromYawPitchRoll(yaw[j], interpolateAlong(m, pitch, s), interpolateAlong(m, roll, s));
+    m.R[j] = so3::from_yaw_pitch_roll(yaw[j], interpolate_along(m, pitch, s), interpolate_along(m, roll, s));
   }
   std::vector<double> lim(nn);
-  for (int j = 0; j < nn; ++j) lim[j] = m.speedLimit(j * m.ds, prof);
+  for (int j = 0; j < nn; ++j) lim[j] = m.speed_limit(j * m.ds, prof);
   for (int j = 0; j + 1 < nn; ++j) {
     const double rate = so3::log(m.R[j].transpose() * m.R[j + 1]).norm() / m.ds;  // rad per metre
     if (rate > 0.0) {
@@ -250,7 +250,7 @@ struct Phase {
 
 // Centred moving average over 2h+1 samples, the ends extended by repeating the end samples (the path
 // stands still there). Orientations are averaged in the tangent space of the centre sample.
-void boxFilter(std::vector<TimedPose>& x, int h) {
+void box_filter(std::vector<TimedPose>& x, int h) {
   if (h <= 0) return;
   const int n = static_cast<int>(x.size());
   auto at = [&](int i) -> const TimedPose& { return x[std::clamp(i, 0, n - 1)]; };
@@ -271,7 +271,7 @@ void boxFilter(std::vector<TimedPose>& x, int h) {
 
 }  // namespace
 
-TrajectoryFitOptions defaultScriptFitOptions() {
+TrajectoryFitOptions default_script_fit_options() {
   TrajectoryFitOptions o;
   o.knot_spacing = 0.1;
   o.position_sigma = 1e-3;
@@ -279,7 +279,7 @@ TrajectoryFitOptions defaultScriptFitOptions() {
   return o;
 }
 
-SmoothTrajectory trajectoryFromTimedWaypoints(const std::vector<Waypoint>& waypoints, const TrajectoryFitOptions& fit,
+SmoothTrajectory trajectory_from_timed_waypoints(const std::vector<Waypoint>& waypoints, const TrajectoryFitOptions& fit,
                                               TrajectoryFitReport* report) {
   std::vector<TimedPose> poses;
   poses.reserve(waypoints.size());
@@ -287,9 +287,9 @@ SmoothTrajectory trajectoryFromTimedWaypoints(const std::vector<Waypoint>& waypo
     const Waypoint& w = waypoints[i];
     if (!std::isfinite(w.yaw) || !std::isfinite(w.pitch) || !std::isfinite(w.roll))
       throw std::invalid_argument("timed waypoint " + std::to_string(i) + ": non-finite angle");
-    poses.push_back({w.t, w.p, Eigen::Quaterniond(so3::fromYawPitchRoll(w.yaw, w.pitch, w.roll))});
+    poses.push_back({w.t, w.p, Eigen::Quaterniond(so3::from_yaw_pitch_roll(w.yaw, w.pitch, w.roll))});
   }
-  return fitTrajectory(poses, fit, report);
+  return fit_trajectory(poses, fit, report);
 }
 
 PathProfile PathProfile::car() {
@@ -324,7 +324,7 @@ PathProfile PathProfile::handheld() {
   return p;
 }
 
-std::vector<TimedPose> densifyPath(const std::vector<PathWaypoint>& w, const PathProfile& prof) {
+std::vector<TimedPose> densify_path(const std::vector<PathWaypoint>& w, const PathProfile& prof) {
   validate(w, prof);
   const int nw = static_cast<int>(w.size());
   // Stops: ends, dwell / stop flags, and corners too sharp to round.
@@ -341,13 +341,13 @@ std::vector<TimedPose> densifyPath(const std::vector<PathWaypoint>& w, const Pat
     pitch[i] = w[i].pitch;
     roll[i] = w[i].roll;
   }
-  const std::vector<double> wp_yaw = unwrappedWaypointYaws(w);
+  const std::vector<double> wp_yaw = unwrapped_waypoint_yaws(w);
   std::vector<Move> moves;
   moves.reserve(stops.size() - 1);
   double last_yaw = prof.heading == HeadingMode::kWaypoints ? wp_yaw[0] : w[0].yaw.value_or(0.0) + prof.yaw_offset;
   for (size_t k = 0; k + 1 < stops.size(); ++k) {
-    moves.push_back(buildMove(w, stops[k], stops[k + 1], prof));
-    profileMove(moves.back(), prof, pitch, roll, wp_yaw, last_yaw);
+    moves.push_back(build_move(w, stops[k], stops[k + 1], prof));
+    profile_move(moves.back(), prof, pitch, roll, wp_yaw, last_yaw);
   }
 
   // Timeline: still, move, (still, turn in place, still), move, ..., still.
@@ -424,14 +424,14 @@ std::vector<TimedPose> densifyPath(const std::vector<PathWaypoint>& w, const Pat
   }
   // Two box passes of half the smoothing time each = a triangle kernel of the full width.
   const int h = static_cast<int>(std::lround(0.25 * prof.smoothing_time / prof.sample_dt));
-  boxFilter(out, h);
-  boxFilter(out, h);
+  box_filter(out, h);
+  box_filter(out, h);
   return out;
 }
 
-SmoothTrajectory trajectoryFromPath(const std::vector<PathWaypoint>& waypoints, const PathProfile& profile,
+SmoothTrajectory trajectory_from_path(const std::vector<PathWaypoint>& waypoints, const PathProfile& profile,
                                     TrajectoryFitReport* report) {
-  return fitTrajectory(densifyPath(waypoints, profile), profile.fit, report);
+  return fit_trajectory(densify_path(waypoints, profile), profile.fit, report);
 }
 
 }  // namespace dynavins::sim

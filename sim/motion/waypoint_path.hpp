@@ -24,7 +24,7 @@
 namespace dynavins::sim {
 
 /// Fit settings for scripted (noise-free) samples: knot spacing 0.1 s.
-TrajectoryFitOptions defaultScriptFitOptions();
+TrajectoryFitOptions default_script_fit_options();
 
 /// One scripted pose at a given time.
 struct Waypoint {
@@ -35,8 +35,8 @@ struct Waypoint {
 
 /// Fits the minimum-jerk spline through timed waypoints (times strictly increasing; consecutive
 /// orientations < 0.9 pi apart). Default fit: knot spacing 0.1 s, waypoints matched to about 1 mm.
-SmoothTrajectory trajectoryFromTimedWaypoints(const std::vector<Waypoint>& waypoints,
-                                              const TrajectoryFitOptions& fit = defaultScriptFitOptions(),
+SmoothTrajectory trajectory_from_timed_waypoints(const std::vector<Waypoint>& waypoints,
+                                              const TrajectoryFitOptions& fit = default_script_fit_options(),
                                               TrajectoryFitReport* report = nullptr);
 
 /// A corner of a geometric path.
@@ -71,7 +71,7 @@ struct PathProfile {
   /// while it turns their steps into ramps: jerk <= 2 * (acceleration step) / smoothing_time.
   double smoothing_time = 0.6;
   double sample_dt = 0.01;            ///< spacing of the dense samples handed to the fit [s]
-  TrajectoryFitOptions fit = defaultScriptFitOptions();
+  TrajectoryFitOptions fit = default_script_fit_options();
 
   static PathProfile car();       ///< 8 m/s, 2.5 m/s^2 lateral, 1.5 m/s^2 longitudinal, 8 m corners, 1.2 s smoothing
   static PathProfile drone();     ///< 1.5 m/s, 1.5 / 1.0 m/s^2, 1 m corners, 0.6 s smoothing
@@ -82,10 +82,10 @@ struct PathProfile {
 /// The end dwell is lengthened by less than sample_dt so that the last sample falls on the grid.
 /// Throws std::invalid_argument for fewer than 2 waypoints, coincident consecutive waypoints, non-finite
 /// values, a missing yaw in kWaypoints mode, or non-positive limits.
-std::vector<TimedPose> densifyPath(const std::vector<PathWaypoint>& waypoints, const PathProfile& profile);
+std::vector<TimedPose> densify_path(const std::vector<PathWaypoint>& waypoints, const PathProfile& profile);
 
-/// densifyPath followed by fitTrajectory with profile.fit.
-SmoothTrajectory trajectoryFromPath(const std::vector<PathWaypoint>& waypoints, const PathProfile& profile,
+/// densify_path followed by fit_trajectory with profile.fit.
+SmoothTrajectory trajectory_from_path(const std::vector<PathWaypoint>& waypoints, const PathProfile& profile,
                                     TrajectoryFitReport* report = nullptr);
 
 }  // namespace dynavins::sim

@@ -19,7 +19,7 @@ struct GroundPose {
   double yaw;
 };
 GroundPose ground_pose(const SmoothTrajectory& body, double t) {
-  t = std::clamp(t, body.tMin(), body.tMax());
+  t = std::clamp(t, body.t_min(), body.t_max());
   const Eigen::Isometry3d T = body.pose(t);
   const Eigen::Vector3d fwd = T.linear().col(0);
   return {T.translation().head<2>(), std::atan2(fwd.y(), fwd.x())};
@@ -114,7 +114,7 @@ std::shared_ptr<const SmoothTrajectory> build_recorded_trajectory(const Scenario
   }
   try {
     TumFitReport report;
-    auto traj = std::make_shared<SmoothTrajectory>(fitTumTrajectory(spec.tum_file, o, &report));
+    auto traj = std::make_shared<SmoothTrajectory>(fit_tum_trajectory(spec.tum_file, o, &report));
     spdlog::info("{}: fitted {} poses of {} (from {:.1f} s), RMS {:.1f} mm / {:.2f} deg", spec.file,
                  report.fit.num_samples, spec.tum_file, spec.tum_start, report.fit.position_rms * 1e3,
                  report.fit.rotation_rms * 180.0 / M_PI);
@@ -135,7 +135,7 @@ std::shared_ptr<const SmoothTrajectory> build_body_trajectory(const ScenarioSpec
     corners.push_back(p);
   }
   try {
-    return std::make_shared<SmoothTrajectory>(trajectoryFromPath(corners, profile_of(spec)));
+    return std::make_shared<SmoothTrajectory>(trajectory_from_path(corners, profile_of(spec)));
   } catch (const std::exception& e) {
     throw std::runtime_error(spec.file + ": motion.waypoints: " + e.what());
   }
@@ -147,7 +147,7 @@ std::shared_ptr<const Scenario> build_scenario(const ScenarioSpec& spec, std::op
   s->spec = spec;
   if (seed) s->spec.seed = *seed;
   s->body = build_body_trajectory(spec);
-  const double path_s = s->body->tMax() - s->body->tMin();
+  const double path_s = s->body->t_max() - s->body->t_min();
   s->duration = std::min(path_s, duration.value_or(spec.duration > 0 ? spec.duration : path_s));
   if (duration && *duration > path_s)
     spdlog::warn("{}: the path lasts {:.1f} s; the sequence is that long, not {:.1f} s", spec.file, path_s, *duration);
@@ -181,7 +181,7 @@ std::shared_ptr<const Scenario> build_scenario(const ScenarioSpec& spec, std::op
 ScenarioSource::ScenarioSource(std::shared_ptr<const Scenario> scenario)
     : scenario_(std::move(scenario)), renderer_(scenario_->rig.camera) {
   const Scenario& s = *scenario_;
-  const auto t0_ns = static_cast<int64_t>(std::ceil(s.body->tMin() * 1e9));
+  const auto t0_ns = static_cast<int64_t>(std::ceil(s.body->t_min() * 1e9));
   const auto t1_ns = t0_ns + static_cast<int64_t>(s.duration * 1e9);
   imu_ = ImuSimulator(s.imu).simulate(*s.body, t0_ns, t1_ns);
   frame_count_ = static_cast<std::size_t>(std::floor(s.duration * s.frame_rate + 1e-9)) + 1;
@@ -189,7 +189,7 @@ ScenarioSource::ScenarioSource(std::shared_ptr<const Scenario> scenario)
 
 StereoFrame ScenarioSource::render_frame(std::size_t k) {
   const Scenario& s = *scenario_;
-  const double t = s.body->tMin() + static_cast<double>(k) / s.frame_rate;
+  const double t = s.body->t_min() + static_cast<double>(k) / s.frame_rate;
   const Eigen::Isometry3d T_wb = s.body->pose(t);
   std::tie(left_, right_) = renderer_.render_stereo(*s.world, t, T_wb * s.rig.T_body_cam0,
                                                     s.rig.T_body_cam0.inverse() * s.rig.T_body_cam1);
@@ -207,7 +207,7 @@ bool ScenarioSource::next(SensorEvent& out) {
   constexpr int64_t kNone = INT64_MAX;
   const int64_t tf = next_frame_ < frame_count_
                          ? s.epoch_ns + static_cast<int64_t>(std::llround(
-                                            (s.body->tMin() + static_cast<double>(next_frame_) / s.frame_rate) * 1e9))
+                                            (s.body->t_min() + static_cast<double>(next_frame_) / s.frame_rate) * 1e9))
                          : kNone;
   const int64_t ti = next_imu_ < imu_.samples.size() ? s.epoch_ns + imu_.samples[next_imu_].t_ns : kNone;
   const int64_t tg = next_gt_ < imu_.truth.size() ? s.epoch_ns + imu_.truth[next_gt_].t_ns : kNone;

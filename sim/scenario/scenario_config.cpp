@@ -6,7 +6,7 @@
 
 namespace dynavins::sim {
 
-EstimatorOptions scenarioEstimatorOptions(const Scenario& scenario) {
+EstimatorOptions scenario_estimator_options(const Scenario& scenario) {
   namespace fs = std::filesystem;
   const fs::path dir = fs::temp_directory_path() / ("dynavins_scenario_config_" + std::to_string(::getpid()));
   io::write_vins_stereo_config(dir.string(), vins_config(scenario));

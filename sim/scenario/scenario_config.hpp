@@ -7,6 +7,6 @@
 
 namespace dynavins::sim {
 
-EstimatorOptions scenarioEstimatorOptions(const Scenario& scenario);
+EstimatorOptions scenario_estimator_options(const Scenario& scenario);
 
 }  // namespace dynavins::sim

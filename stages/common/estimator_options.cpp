@@ -17,8 +17,8 @@ using O = EstimatorOptions;
 
 // The option table: one line per scalar key. Ranges reject what cannot be meant (a window of 1 frame
 // gave a 2.7 m ATE, one of 10^8 frames 14 GB); they are not tuning advice.
-const std::vector<OptionSpec>& optionSpecs() {
-  static const std::vector<OptionSpec> table{
+const std::vector<OptionSpec>& option_specs() {
+  static const std::vector<OptionSpec> kTable{
       {"estimate_extrinsic", &O::estimate_extrinsic, {0, 2}, "", "VINS-Fusion: 0 fixed, 1 refine, 2 calibrate; here the extrinsic stays fixed (2 allows no body_T_cam)"},
       // Feature tracker.
       {"max_cnt", &O::max_cnt, {10, 2000}, "", "features kept per frame"},
@@ -61,11 +61,11 @@ const std::vector<OptionSpec>& optionSpecs() {
       {"zupt_max_velocity", &O::zupt_max_velocity, {0, 10}, "m/s", "at rest only below this speed of the last solve"},
       {"zupt_max_disparity", &O::zupt_max_disparity, {0, 50}, "px", "at rest only below this median rotation-compensated motion"},
   };
-  return table;
+  return kTable;
 }
 
-const std::vector<std::pair<std::string, std::string>>& rigKeys() {
-  static const std::vector<std::pair<std::string, std::string>> keys{
+const std::vector<std::pair<std::string, std::string>>& rig_keys() {
+  static const std::vector<std::pair<std::string, std::string>> kKeys{
       {"imu", "1 with an IMU, 0 without (required)"},
       {"num_of_cam", "1 (mono) or 2 (stereo) (required)"},
       {"image_width", "px (required)"},
@@ -75,11 +75,11 @@ const std::vector<std::pair<std::string, std::string>>& rigKeys() {
       {"body_T_cam0", "4x4 !!opencv-matrix, camera to IMU body (may be absent with estimate_extrinsic 2)"},
       {"body_T_cam1", "the same for the right camera (stereo)"},
   };
-  return keys;
+  return kKeys;
 }
 
-const std::vector<std::string>& knownUnusedKeys() {
-  static const std::vector<std::string> keys{
+const std::vector<std::string>& known_unused_keys() {
+  static const std::vector<std::string> kKeys{
       // VINS-Fusion (and VINS-Fusion-gpu) configs.
       "imu_topic", "image0_topic", "image1_topic", "output_path", "multiple_thread", "load_previous_pose_graph",
       "pose_graph_save_path", "save_image", "use_gpu", "use_gpu_acc_flow", "use_gpu_ceres",
@@ -91,7 +91,7 @@ const std::vector<std::string>& knownUnusedKeys() {
       // The authors' DynaVINS configs (visualisation, test switch and their loop closure).
       "show_image_feat_weight", "max_depth", "test_mono", "min_score_static", "min_overlap", "max_keyframe",
       "hypodiff_dist", "hypodiff_yaw", "hypo_regularization", "hypo_alternating_converge", "min_loop"};
-  return keys;
+  return kKeys;
 }
 
 namespace {
@@ -115,11 +115,11 @@ template <typename T>
 constexpr bool kIsFlag = std::is_same_v<T, bool>;
 
 template <typename T>
-const char* typeName() {
+const char* type_name() {
   return kIsFlag<T> ? "bool" : std::is_same_v<T, int> ? "int" : "real";
 }
 
-std::string rangeText(const OptionSpec& s) {
+std::string range_text(const OptionSpec& s) {
   return std::visit(
       [&](auto m) -> std::string {
         using T = std::remove_reference_t<decltype(EstimatorOptions{}.*m)>;
@@ -133,28 +133,28 @@ std::string rangeText(const OptionSpec& s) {
 }
 
 // Empty when `x` is in the key's range, else what is wrong with it.
-std::string rangeProblem(const OptionSpec& s, double x) {
+std::string range_problem(const OptionSpec& s, double x) {
   const OptionRange& g = s.range;
   if (!std::isfinite(x)) return "must be a finite number, got " + number(x);
   if (x < g.lo || x > g.hi || (g.lo_open && x == g.lo))
-    return std::string("must be in ") + rangeText(s) + (*s.unit ? std::string(" ") + s.unit : "") + ", got " +
+    return std::string("must be in ") + range_text(s) + (*s.unit ? std::string(" ") + s.unit : "") + ", got " +
            number(x);
   return {};
 }
 
-const OptionSpec* findSpec(const std::string& key) {
-  for (const OptionSpec& s : optionSpecs())
+const OptionSpec* find_spec(const std::string& key) {
+  for (const OptionSpec& s : option_specs())
     if (key == s.key) return &s;
   return nullptr;
 }
 
-bool isRigKey(const std::string& key) {
-  for (const auto& [k, help] : rigKeys())
+bool is_rig_key(const std::string& key) {
+  for (const auto& [k, help] : rig_keys())
     if (k == key) return true;
   return false;
 }
 
-std::size_t editDistance(const std::string& a, const std::string& b) {
+std::size_t edit_distance(const std::string& a, const std::string& b) {
   std::vector<std::size_t> row(b.size() + 1);
   for (std::size_t j = 0; j <= b.size(); ++j) row[j] = j;
   for (std::size_t i = 1; i <= a.size(); ++i) {
@@ -170,22 +170,22 @@ std::size_t editDistance(const std::string& a, const std::string& b) {
 }
 
 // Our key closest to `key` within 2 edits, or "".
-std::string nearestKey(const std::string& key) {
+std::string nearest_key(const std::string& key) {
   std::string best;
   std::size_t best_d = 3;
   auto consider = [&](const std::string& k) {
-    const std::size_t d = editDistance(key, k);
+    const std::size_t d = edit_distance(key, k);
     if (d < best_d) best = k, best_d = d;
   };
-  for (const OptionSpec& s : optionSpecs()) consider(s.key);
-  for (const auto& [k, help] : rigKeys()) consider(k);
+  for (const OptionSpec& s : option_specs()) consider(s.key);
+  for (const auto& [k, help] : rig_keys()) consider(k);
   return best;
 }
 
 void derive(EstimatorOptions& o) { o.lambda_w = o.regularization_gamma * o.regularization_gamma; }
 
 // Reads one table key from the file (absent: the default stays), checked against its range.
-void loadOption(const ConfigReader& r, EstimatorOptions& o, const OptionSpec& s) {
+void load_option(const ConfigReader& r, EstimatorOptions& o, const OptionSpec& s) {
   if (s.imu_only && !o.use_imu) return;
   // VINS-Fusion reads the IMU keys unconditionally (a missing one silently becomes 0); with an IMU we insist.
   if (!r.has(s.key)) {
@@ -201,7 +201,7 @@ void loadOption(const ConfigReader& r, EstimatorOptions& o, const OptionSpec& s)
           T v;
           if constexpr (std::is_same_v<T, int>) v = *r.find_int(s.key);
           else v = *r.find_double(s.key);
-          const std::string problem = rangeProblem(s, v);
+          const std::string problem = range_problem(s, v);
           if (!problem.empty()) r.fail(s.key, problem);
           o.*m = v;
         }
@@ -211,12 +211,12 @@ void loadOption(const ConfigReader& r, EstimatorOptions& o, const OptionSpec& s)
 }
 
 // Top-level keys of the file that are neither ours nor known to be read past; each is warned.
-std::vector<std::string> unknownKeys(const ConfigReader& r) {
-  const auto& unused = knownUnusedKeys();
+std::vector<std::string> find_unknown_keys(const ConfigReader& r) {
+  const auto& unused = known_unused_keys();
   std::vector<std::string> out;
   for (const std::string& k : r.keys()) {
-    if (findSpec(k) || isRigKey(k) || std::find(unused.begin(), unused.end(), k) != unused.end()) continue;
-    const std::string near = nearestKey(k);
+    if (find_spec(k) || is_rig_key(k) || std::find(unused.begin(), unused.end(), k) != unused.end()) continue;
+    const std::string near = nearest_key(k);
     spdlog::warn("{}: unknown key '{}' (ignored){}", r.path(), k, near.empty() ? "" : "; did you mean " + near + "?");
     out.push_back(k);
   }
@@ -241,7 +241,7 @@ EstimatorOptions EstimatorOptions::load(const std::string& path) {
   if (o.image_width <= 0) r.fail("image_width", "must be positive");
   if (o.image_height <= 0) r.fail("image_height", "must be positive");
 
-  for (const OptionSpec& s : optionSpecs()) loadOption(r, o, s);
+  for (const OptionSpec& s : option_specs()) load_option(r, o, s);
 
   for (int i = 0; i < o.num_of_cam; ++i) {
     const std::string calib_key = "cam" + std::to_string(i) + "_calib";
@@ -263,12 +263,12 @@ EstimatorOptions EstimatorOptions::load(const std::string& path) {
                    cam.height(), o.image_width, o.image_height);
   }
   derive(o);
-  o.unknown_keys = unknownKeys(r);
+  o.unknown_keys = find_unknown_keys(r);
   return o;
 }
 
 std::string EstimatorOptions::value(const std::string& key) const {
-  const OptionSpec* s = findSpec(key);
+  const OptionSpec* s = find_spec(key);
   if (!s) throw ConfigError(config_file, key, "not a key of the option table");
   return std::visit([&](auto m) { return text(this->*m); }, s->field);
 }
@@ -296,7 +296,7 @@ std::string EstimatorOptions::print() const {
     T << "]";
     line("body_T_cam" + n, T.str());
   }
-  for (const OptionSpec& o : optionSpecs()) {
+  for (const OptionSpec& o : option_specs()) {
     if (o.imu_only && !use_imu) continue;
     line(o.key, value(o.key), *o.unit ? std::string(" [") + o.unit + "]" : "");
     // The one derived option, shown under the key it comes from.
@@ -306,19 +306,19 @@ std::string EstimatorOptions::print() const {
   return s.str();
 }
 
-std::string optionsMarkdownTable() {
+std::string options_markdown_table() {
   std::ostringstream s;
   const EstimatorOptions defaults;
   s << "| Key | Type | Default | Range | Unit | Meaning |\n";
   s << "|---|---|---|---|---|---|\n";
-  for (const OptionSpec& o : optionSpecs()) {
+  for (const OptionSpec& o : option_specs()) {
     const std::string type = std::visit(
-        [](auto m) { return std::string(typeName<std::remove_reference_t<decltype(EstimatorOptions{}.*m)>>()); },
+        [](auto m) { return std::string(type_name<std::remove_reference_t<decltype(EstimatorOptions{}.*m)>>()); },
         o.field);
-    s << "| `" << o.key << "` | " << type << " | " << defaults.value(o.key) << " | " << rangeText(o) << " | " << o.unit
+    s << "| `" << o.key << "` | " << type << " | " << defaults.value(o.key) << " | " << range_text(o) << " | " << o.unit
       << " | " << o.help << (o.imu_only ? " (required with `imu: 1`)" : "") << " |\n";
   }
-  for (const auto& [key, help] : rigKeys())
+  for (const auto& [key, help] : rig_keys())
     s << "| `" << key << "` | rig |  |  |  | " << help << "; file only, not `--set` |\n";
   return s.str();
 }
@@ -364,18 +364,18 @@ bool parse_bool(const std::string& key, const std::string& v) {
   bad(key, "expected true/false/1/0, got '" + v + "'");
 }
 
-std::string unknownOverride(const std::string& key) {
-  const std::string near = nearestKey(key);
+std::string unknown_override(const std::string& key) {
+  const std::string near = nearest_key(key);
   std::string msg = "unknown option";
   if (!near.empty()) msg += "; did you mean " + near + "?";
   msg += " Valid keys:";
-  for (const OptionSpec& s : optionSpecs()) msg += std::string(" ") + s.key;
+  for (const OptionSpec& s : option_specs()) msg += std::string(" ") + s.key;
   return msg;
 }
 
 }  // namespace
 
-std::pair<std::string, std::string> EstimatorOptions::parseOverride(const std::string& text) {
+std::pair<std::string, std::string> EstimatorOptions::parse_override(const std::string& text) {
   const auto eq = text.find('=');
   if (eq == std::string::npos) bad("", "expected key=value, got '" + text + "'");
   std::pair<std::string, std::string> kv{trim(text.substr(0, eq)), trim(text.substr(eq + 1))};
@@ -385,9 +385,9 @@ std::pair<std::string, std::string> EstimatorOptions::parseOverride(const std::s
 }
 
 void EstimatorOptions::apply(const std::string& key, const std::string& value) {
-  if (isRigKey(key)) bad(key, "describes the sensor rig and cannot be overridden; edit the yaml");
-  const OptionSpec* s = findSpec(key);
-  if (!s) bad(key, unknownOverride(key));
+  if (is_rig_key(key)) bad(key, "describes the sensor rig and cannot be overridden; edit the yaml");
+  const OptionSpec* s = find_spec(key);
+  if (!s) bad(key, unknown_override(key));
   std::visit(
       [&](auto m) {
         using T = std::remove_reference_t<decltype(this->*m)>;
@@ -397,7 +397,7 @@ void EstimatorOptions::apply(const std::string& key, const std::string& value) {
           T v;
           if constexpr (std::is_same_v<T, int>) v = parse_int(key, value);
           else v = parse_double(key, value);
-          const std::string problem = rangeProblem(*s, v);
+          const std::string problem = range_problem(*s, v);
           if (!problem.empty()) bad(key, problem);
           this->*m = v;
         }

@@ -4,7 +4,7 @@
 //
 // Each scalar key is declared once, in the option table of estimator_options.cpp (key, field, range,
 // unit, help); its default is the field's initializer below. The yaml loader, `--set`, print() and
-// the README's key table (optionsMarkdownTable()) all read that table. Adding a key: a field here and
+// the README's key table (options_markdown_table()) all read that table. Adding a key: a field here and
 // one line in the table. The rig keys (imu, num_of_cam, image_*, cam*_calib, body_T_cam*) are read
 // from the file only, explicitly in load().
 //
@@ -83,7 +83,7 @@ struct EstimatorOptions {
   bool weighted_huber = true;
   /// Ours, not the paper's: the state step of the alternation gives a kept feature (eq. 10 weight at or
   /// above the weight of a one-sigma track, 0.5 at lambda_w = 1) its full weight, as Huber does, and a
-  /// rejected one its weight relative to that (feature_weights.hpp, stateStepWeight). 0 (default) = the
+  /// rejected one its weight relative to that (feature_weights.hpp, state_step_weight). 0 (default) = the
   /// paper's w_j^2 on every feature; off by default: it helped the fast street twins and hurt `none`
   /// (README, "Street scenes").
   bool kept_full_weight = false;
@@ -114,7 +114,7 @@ struct EstimatorOptions {
   /// overridden (cameras, image size), or a bad value.
   void apply(const std::string& key, const std::string& value);
   /// Splits "key=value" (both non-empty, whitespace trimmed); throws ConfigError("--set", ...) otherwise.
-  static std::pair<std::string, std::string> parseOverride(const std::string& text);
+  static std::pair<std::string, std::string> parse_override(const std::string& text);
   /// Every effective option, one per line, with "(file)", "(--set)" or "(default)".
   std::string print() const;
   /// The effective value of one table key as print() shows it; throws ConfigError for other keys.
@@ -138,12 +138,12 @@ struct OptionSpec {
 };
 
 /// The option table, in print order.
-const std::vector<OptionSpec>& optionSpecs();
+const std::vector<OptionSpec>& option_specs();
 /// The rig keys (read from the file only): name and meaning.
-const std::vector<std::pair<std::string, std::string>>& rigKeys();
+const std::vector<std::pair<std::string, std::string>>& rig_keys();
 /// Keys of VINS-Fusion (and VINS-Mono, VINS-Fusion-gpu, the authors' DynaVINS) that we read past.
-const std::vector<std::string>& knownUnusedKeys();
+const std::vector<std::string>& known_unused_keys();
 /// Every key of the table and the rig as a Markdown table (README.md's "Configuration keys").
-std::string optionsMarkdownTable();
+std::string options_markdown_table();
 
 }  // namespace dynavins

@@ -49,7 +49,7 @@ inline Eigen::Vector3d log(const Eigen::Matrix3d& R) {
 }
 
 /// Right Jacobian Jr(phi) of SO(3).
-inline Eigen::Matrix3d rightJacobian(const Eigen::Vector3d& phi) {
+inline Eigen::Matrix3d right_jacobian(const Eigen::Vector3d& phi) {
   const double th2 = phi.squaredNorm();
   const Eigen::Matrix3d k = hat(phi);
   double a, b;  // (1-cos th)/th^2 and (th - sin th)/th^3
@@ -65,7 +65,7 @@ inline Eigen::Matrix3d rightJacobian(const Eigen::Vector3d& phi) {
 }
 
 /// Inverse right Jacobian Jr(phi)^-1.
-inline Eigen::Matrix3d rightJacobianInverse(const Eigen::Vector3d& phi) {
+inline Eigen::Matrix3d right_jacobian_inverse(const Eigen::Vector3d& phi) {
   const double th2 = phi.squaredNorm();
   const Eigen::Matrix3d k = hat(phi);
   double c;  // 1/th^2 - (1+cos th)/(2 th sin th)
@@ -79,12 +79,12 @@ inline Eigen::Matrix3d rightJacobianInverse(const Eigen::Vector3d& phi) {
 }
 
 /// Inverse left Jacobian Jl(phi)^-1 = Jr(-phi)^-1: Log(Exp(δ) Exp(φ)) ≈ φ + Jl(φ)^-1 δ.
-inline Eigen::Matrix3d leftJacobianInverse(const Eigen::Vector3d& phi) {
-  return rightJacobianInverse(-phi);
+inline Eigen::Matrix3d left_jacobian_inverse(const Eigen::Vector3d& phi) {
+  return right_jacobian_inverse(-phi);
 }
 
 /// Rotation matrix for intrinsic Z-Y-X angles: R = Rz(yaw) * Ry(pitch) * Rx(roll).
-inline Eigen::Matrix3d fromYawPitchRoll(double yaw, double pitch, double roll) {
+inline Eigen::Matrix3d from_yaw_pitch_roll(double yaw, double pitch, double roll) {
   return (Eigen::AngleAxisd(yaw, Eigen::Vector3d::UnitZ()) *
           Eigen::AngleAxisd(pitch, Eigen::Vector3d::UnitY()) *
           Eigen::AngleAxisd(roll, Eigen::Vector3d::UnitX()))

@@ -4,12 +4,12 @@
 
 namespace dynavins::estimator {
 
-BaLoss parseBaLoss(const std::string& s) {
+BaLoss parse_ba_loss(const std::string& s) {
   if (s == "huber") return BaLoss::Huber;
   if (s == "dynavins") return BaLoss::Dynavins;
   throw std::invalid_argument("unknown BA loss '" + s + "' (expected huber or dynavins)");
 }
 
-const char* toString(BaLoss loss) { return loss == BaLoss::Huber ? "huber" : "dynavins"; }
+const char* to_string(BaLoss loss) { return loss == BaLoss::Huber ? "huber" : "dynavins"; }
 
 }  // namespace dynavins::estimator

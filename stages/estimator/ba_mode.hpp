@@ -11,7 +11,7 @@ enum class BaLoss {
 };
 
 /// "huber" / "dynavins"; throws std::invalid_argument naming the value otherwise.
-BaLoss parseBaLoss(const std::string& s);
-const char* toString(BaLoss loss);
+BaLoss parse_ba_loss(const std::string& s);
+const char* to_string(BaLoss loss);
 
 }  // namespace dynavins::estimator

@@ -50,19 +50,19 @@ struct FeatureWeightParams {
 
 /// Closed-form minimiser of eq. (10) over w ∈ [0, 1] for mean whitened squared residual `r`, previous
 /// weight `w_prev` and solve count `n` (momentum ignored when n == 0 or λm == 0).
-double solveFeatureWeight(double r, double w_prev, int n, const FeatureWeightParams& p);
+double solve_feature_weight(double r, double w_prev, int n, const FeatureWeightParams& p);
 
 /// The weight the state step applies to a feature of eq. (10) weight `w` (ŵ_j above).
-double stateStepWeight(double w, const FeatureWeightParams& p);
+double state_step_weight(double w, const FeatureWeightParams& p);
 
 /// The value of eq. (10) at weight `w` (used by tests and for the converged loss).
-double featureWeightCost(double w, double r, double w_prev, int n, const FeatureWeightParams& p);
+double feature_weight_cost(double w, double r, double w_prev, int n, const FeatureWeightParams& p);
 
 /// Mean of squared whitened residual norms (per observation). Empty input gives 0.
-double meanSquaredResidual(const std::vector<double>& squared_norms);
+double mean_squared_residual(const std::vector<double>& squared_norms);
 
 /// The r_j above from the squared whitened norms of a feature's 2-D reprojection residuals: their mean,
 /// per residual component when p.residual_per_component.
-double featureResidualScale(const std::vector<double>& squared_norms, const FeatureWeightParams& p);
+double feature_residual_scale(const std::vector<double>& squared_norms, const FeatureWeightParams& p);
 
 }  // namespace dynavins::estimator

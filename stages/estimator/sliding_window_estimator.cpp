@@ -23,7 +23,7 @@ namespace {
 
 using Clock = std::chrono::steady_clock;
 
-WindowSolveOptions solveOptions(const EstimatorOptions& o, const EstimatorMode& m) {
+WindowSolveOptions solve_options(const EstimatorOptions& o, const EstimatorMode& m) {
   WindowSolveOptions s;
   s.loss = m.loss;
   s.stereo = m.stereo;
@@ -45,7 +45,7 @@ WindowSolveOptions solveOptions(const EstimatorOptions& o, const EstimatorMode& 
   return s;
 }
 
-StandstillOptions standstillOptions(const EstimatorOptions& o) {
+StandstillOptions standstill_options(const EstimatorOptions& o) {
   StandstillOptions s;
   s.enabled = o.zupt;
   s.max_speed = o.zupt_max_velocity;
@@ -53,7 +53,7 @@ StandstillOptions standstillOptions(const EstimatorOptions& o) {
   return s;
 }
 
-Eigen::Isometry3d extrinsicOf(const std::array<double, kPoseSize>& e) {
+Eigen::Isometry3d extrinsic_of(const std::array<double, kPoseSize>& e) {
   Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
   T.linear() = Eigen::Quaterniond(e[6], e[3], e[4], e[5]).toRotationMatrix();
   T.translation() = Eigen::Vector3d(e[0], e[1], e[2]);
@@ -64,7 +64,7 @@ Eigen::Isometry3d extrinsicOf(const std::array<double, kPoseSize>& e) {
 
 struct SlidingWindowEstimator::Impl {
   Impl(const EstimatorOptions& o, EstimatorMode m)
-      : opt(o), mode(m), W(o.window_size), state(o.window_size), optimizer(solveOptions(o, m)),
+      : opt(o), mode(m), W(o.window_size), state(o.window_size), optimizer(solve_options(o, m)),
         slot_seq(o.window_size + 1, 0), slot_image(o.window_size + 1) {
     if (m.stereo && o.num_of_cam < 2) throw std::invalid_argument("stereo mode needs num_of_cam: 2 in " + o.config_file);
     for (int c = 0; c < std::min<int>(2, static_cast<int>(o.body_T_cam.size())); ++c) {
@@ -73,21 +73,21 @@ struct SlidingWindowEstimator::Impl {
       state.extrinsic[c] = {p.x(), p.y(), p.z(), q.x(), q.y(), q.z(), q.w()};
     }
     if (o.body_T_cam.size() < 2) state.extrinsic[1] = state.extrinsic[0];
-    T_c0c1 = extrinsicOf(state.extrinsic[0]).inverse() * extrinsicOf(state.extrinsic[1]);
+    T_c0c1 = extrinsic_of(state.extrinsic[0]).inverse() * extrinsic_of(state.extrinsic[1]);
   }
 
   WindowEstimate process(const TrackedFrame& frame, const PreintegratedInterval* imu);
-  void resetAll();
-  bool predictNewest(const PreintegratedInterval& imu, std::string* why);
-  bool initializeStereo(std::string* why);
-  bool initializeMonoWindow(std::string* why);
-  void pnpNewest();
-  std::string failureReason(const Eigen::Vector3d& last_p, const Eigen::Quaterniond& last_q);
+  void reset_all();
+  bool predict_newest(const PreintegratedInterval& imu, std::string* why);
+  bool initialize_stereo(std::string* why);
+  bool initialize_mono_window(std::string* why);
+  void pnp_newest();
+  std::string failure_reason(const Eigen::Vector3d& last_p, const Eigen::Quaterniond& last_q);
   void slide(bool keep_second_newest);
-  void fillOutput(WindowEstimate& e);
-  Keyframe makeKeyframe(int slot) const;
+  void fill_output(WindowEstimate& e);
+  Keyframe make_keyframe(int slot) const;
   /// Appends the keyframes of slots [0, end) not handed out yet (time order).
-  void emitKeyframes(int end, std::vector<Keyframe>& out);
+  void emit_keyframes(int end, std::vector<Keyframe>& out);
   SlotCameraPose cams() const {
     return [this](int k) { return state.camera(k, 0); };
   }
@@ -110,7 +110,7 @@ struct SlidingWindowEstimator::Impl {
   int64_t last_emitted_t_ns = INT64_MIN;  ///< newest keyframe handed out (each goes out once)
 };
 
-void SlidingWindowEstimator::Impl::resetAll() {
+void SlidingWindowEstimator::Impl::reset_all() {
   const auto extrinsic = state.extrinsic;  // fixed from config: survives resets
   state = WindowState(W);
   state.extrinsic = extrinsic;
@@ -122,27 +122,27 @@ void SlidingWindowEstimator::Impl::resetAll() {
   gravity_aligned = false;
 }
 
-bool SlidingWindowEstimator::Impl::predictNewest(const PreintegratedInterval& imu, std::string* why) {
+bool SlidingWindowEstimator::Impl::predict_newest(const PreintegratedInterval& imu, std::string* why) {
   const int i = newest - 1, j = newest;
   if (imu.t_begin_ns != state.t_ns[i]) {
     *why = "IMU interval starts at " + std::to_string(imu.t_begin_ns) + " ns, previous frame at " +
            std::to_string(state.t_ns[i]) + " ns";
     return false;
   }
-  auto pre = std::make_unique<ImuPreintegration>(imu.preint);
+  auto pre = std::make_unique<imu::ImuPreintegration>(imu.preint);
   const Eigen::Vector3d ba = state.ba(i), bg = state.bg(i);
-  if (pre->linearizedBa() != ba || pre->linearizedBg() != bg) pre->repropagate(ba, bg);
+  if (pre->linearized_ba() != ba || pre->linearized_bg() != bg) pre->repropagate(ba, bg);
   if (!gravity_aligned) {
     // First IMU of the run: level the first frame with the mean specific force (VINS' initFirstIMUPose).
     Eigen::Vector3d f = Eigen::Vector3d::Zero();
     for (const ImuSample& smp : pre->samples()) f += smp.acc;
-    state.q(i) = Eigen::Quaterniond(gravityAlignedRotation(f / pre->samples().size()));
+    state.q(i) = Eigen::Quaterniond(gravity_aligned_rotation(f / pre->samples().size()));
     gravity_aligned = true;
   }
   Eigen::Vector3d alpha, beta;
   Eigen::Quaterniond gamma;
-  pre->correctedDeltas(ba, bg, alpha, gamma, beta);
-  const double dt = pre->sumDt();
+  pre->corrected_deltas(ba, bg, alpha, gamma, beta);
+  const double dt = pre->sum_dt();
   const Eigen::Vector3d g_w(0, 0, -opt.g_norm);
   const Eigen::Quaterniond qi = state.q(i);
   state.p(j) = state.p(i) + state.v(i) * dt + 0.5 * g_w * dt * dt + qi * alpha;
@@ -154,13 +154,13 @@ bool SlidingWindowEstimator::Impl::predictNewest(const PreintegratedInterval& im
   return true;
 }
 
-void SlidingWindowEstimator::Impl::pnpNewest() {
+void SlidingWindowEstimator::Impl::pnp_newest() {
   // Pose of the newest frame from the window's triangulated points (VINS-Fusion's initFramePoseByPnP),
   // with RANSAC so that a moving object cannot drag it; the IMU prediction is the initial guess.
   std::vector<cv::Point3f> pts;
   std::vector<cv::Point2f> obs;
   for (const auto& [id, f] : features.all()) {
-    if (!f.has_depth || f.start_slot >= newest || f.endSlot() != newest) continue;
+    if (!f.has_depth || f.start_slot >= newest || f.end_slot() != newest) continue;
     const CameraPose a = state.camera(f.start_slot, 0);
     const Eigen::Vector3d p_w = a.R * (Eigen::Vector3d(f.obs[0].xy.x(), f.obs[0].xy.y(), 1.0) / f.inv_depth) + a.p;
     const Eigen::Vector2d& xy = f.obs.back().xy;
@@ -185,7 +185,7 @@ void SlidingWindowEstimator::Impl::pnpNewest() {
   cv::cv2eigen(R_cv, R_cw_new);
   cv::cv2eigen(tvec, t_cw_new);
   // cam pose -> body pose through the fixed extrinsic.
-  const Eigen::Isometry3d T_bc = extrinsicOf(state.extrinsic[0]);
+  const Eigen::Isometry3d T_bc = extrinsic_of(state.extrinsic[0]);
   const Eigen::Matrix3d R_wc = R_cw_new.transpose();
   const Eigen::Vector3d p_wc = -R_wc * t_cw_new;
   const Eigen::Matrix3d R_wb = R_wc * T_bc.linear().transpose();
@@ -193,7 +193,7 @@ void SlidingWindowEstimator::Impl::pnpNewest() {
   state.p(newest) = p_wc - R_wb * T_bc.translation();
 }
 
-bool SlidingWindowEstimator::Impl::initializeStereo(std::string* why) {
+bool SlidingWindowEstimator::Impl::initialize_stereo(std::string* why) {
   // VINS-Fusion's stereo-inertial start: poses by PnP on stereo points while the window fills, then the
   // gyroscope bias from those rotations, velocities from the positions, and a full window solve.
   int with_depth = 0;
@@ -203,12 +203,12 @@ bool SlidingWindowEstimator::Impl::initializeStereo(std::string* why) {
     return false;
   }
   std::vector<Eigen::Matrix3d> R_wb;
-  std::vector<const ImuPreintegration*> pre;
+  std::vector<const imu::ImuPreintegration*> pre;
   for (int k = 0; k <= newest; ++k) {
     R_wb.push_back(state.q(k).toRotationMatrix());
     if (k > 0) pre.push_back(state.preint[k].get());
   }
-  const Eigen::Vector3d dbg = estimateGyroBias(R_wb, pre);
+  const Eigen::Vector3d dbg = estimate_gyro_bias(R_wb, pre);
   if (dbg.norm() > 0.5) {
     *why = "gyroscope bias estimate " + std::to_string(dbg.norm()) + " rad/s is implausible";
     return false;
@@ -226,7 +226,7 @@ bool SlidingWindowEstimator::Impl::initializeStereo(std::string* why) {
   return true;
 }
 
-bool SlidingWindowEstimator::Impl::initializeMonoWindow(std::string* why) {
+bool SlidingWindowEstimator::Impl::initialize_mono_window(std::string* why) {
   std::vector<InitWindowFrame> window(newest + 1);
   for (int k = 0; k <= newest; ++k) {
     window[k].t = state.t_ns[k] * 1e-9;
@@ -235,10 +235,10 @@ bool SlidingWindowEstimator::Impl::initializeMonoWindow(std::string* why) {
   for (const auto& [id, f] : features.all()) {
     for (size_t o = 0; o < f.obs.size(); ++o) window[f.start_slot + o].features[id] = f.obs[o].xy;
   }
-  const Eigen::Isometry3d T_bc = extrinsicOf(state.extrinsic[0]);
+  const Eigen::Isometry3d T_bc = extrinsic_of(state.extrinsic[0]);
   MonoInitOptions mo;
   mo.alignment.gravity_norm = opt.g_norm;
-  const MonoInitResult r = initializeMono(window, T_bc.linear(), T_bc.translation(), mo);
+  const MonoInitResult r = initialize_mono(window, T_bc.linear(), T_bc.translation(), mo);
   if (!r.success) {
     *why = r.reason;
     return false;
@@ -265,10 +265,10 @@ bool SlidingWindowEstimator::Impl::initializeMonoWindow(std::string* why) {
   return true;
 }
 
-std::string SlidingWindowEstimator::Impl::failureReason(const Eigen::Vector3d& last_p,
+std::string SlidingWindowEstimator::Impl::failure_reason(const Eigen::Vector3d& last_p,
                                                         const Eigen::Quaterniond& last_q) {
   // VINS-Fusion's failureDetection thresholds.
-  if (features.lastTrackedCount() < 2) return "fewer than 2 features tracked";
+  if (features.last_tracked_count() < 2) return "fewer than 2 features tracked";
   if (state.ba(newest).norm() > 2.5) return "accelerometer bias estimate above 2.5 m/s^2";
   if (state.bg(newest).norm() > 1.0) return "gyroscope bias estimate above 1 rad/s";
   const Eigen::Vector3d dp = state.p(newest) - last_p;
@@ -281,23 +281,23 @@ std::string SlidingWindowEstimator::Impl::failureReason(const Eigen::Vector3d& l
 
 void SlidingWindowEstimator::Impl::slide(bool keep_second_newest) {
   if (keep_second_newest) {
-    if (tracking) optimizer.marginalizeOldest(state, newest, features);
-    features.removeOldest(cams());
+    if (tracking) optimizer.marginalize_oldest(state, newest, features);
+    features.remove_oldest(cams());
     for (int k = 0; k < newest; ++k) {
-      state.moveSlot(k + 1, k);
+      state.move_slot(k + 1, k);
       slot_seq[k] = slot_seq[k + 1];
       slot_image[k] = std::move(slot_image[k + 1]);  // the oldest's image is released here
     }
     state.preint[0].reset();
   } else {
-    if (tracking) optimizer.marginalizeSecondNewest(state, newest);
+    if (tracking) optimizer.marginalize_second_newest(state, newest);
     // Fold the newest interval into the second newest's so the IMU chain stays unbroken.
-    ImuPreintegration& merged = *state.preint[newest - 1];
+    imu::ImuPreintegration& merged = *state.preint[newest - 1];
     const auto& samples = state.preint[newest]->samples();
     for (size_t k = 1; k < samples.size(); ++k) merged.integrate(samples[k]);
-    features.removeSlot(newest - 1, cams());
+    features.remove_slot(newest - 1, cams());
     auto keep = std::move(state.preint[newest - 1]);
-    state.moveSlot(newest, newest - 1);
+    state.move_slot(newest, newest - 1);
     state.preint[newest - 1] = std::move(keep);
     slot_seq[newest - 1] = slot_seq[newest];
     slot_image[newest - 1] = std::move(slot_image[newest]);  // the dropped frame's image is released here
@@ -306,7 +306,7 @@ void SlidingWindowEstimator::Impl::slide(bool keep_second_newest) {
   --newest;
 }
 
-void SlidingWindowEstimator::Impl::fillOutput(WindowEstimate& e) {
+void SlidingWindowEstimator::Impl::fill_output(WindowEstimate& e) {
   e.status = EstimatorStatus::Tracking;
   NavState& ns = e.state;
   ns.t_ns = state.t_ns[newest];
@@ -317,7 +317,7 @@ void SlidingWindowEstimator::Impl::fillOutput(WindowEstimate& e) {
   ns.bias_gyr = state.bg(newest);
   e.features.t_ns = ns.t_ns;
   for (const auto& [id, f] : features.all()) {
-    if (!f.inBa() || f.times_solved == 0) continue;
+    if (!f.in_ba() || f.times_solved == 0) continue;
     const CameraPose a = state.camera(f.start_slot, 0);
     WeightedFeature wf;
     wf.id = id;
@@ -336,7 +336,7 @@ void SlidingWindowEstimator::Impl::fillOutput(WindowEstimate& e) {
   }
 }
 
-Keyframe SlidingWindowEstimator::Impl::makeKeyframe(int slot) const {
+Keyframe SlidingWindowEstimator::Impl::make_keyframe(int slot) const {
   Keyframe kf;
   kf.t_ns = state.t_ns[slot];
   kf.seq = slot_seq[slot];
@@ -347,7 +347,7 @@ Keyframe SlidingWindowEstimator::Impl::makeKeyframe(int slot) const {
   kf.q_bc = Eigen::Quaterniond(e[6], e[3], e[4], e[5]);
   kf.image = slot_image[slot];  // shallow copy
   for (const auto& [id, f] : features.all()) {
-    if (f.start_slot > slot || f.endSlot() < slot) continue;
+    if (f.start_slot > slot || f.end_slot() < slot) continue;
     const FeatureObservation& o = f.obs[slot - f.start_slot];
     KeyframePoint p;
     p.id = id;
@@ -364,10 +364,10 @@ Keyframe SlidingWindowEstimator::Impl::makeKeyframe(int slot) const {
   return kf;
 }
 
-void SlidingWindowEstimator::Impl::emitKeyframes(int end, std::vector<Keyframe>& out) {
+void SlidingWindowEstimator::Impl::emit_keyframes(int end, std::vector<Keyframe>& out) {
   for (int k = 0; k < end; ++k) {
     if (state.t_ns[k] <= last_emitted_t_ns) continue;
-    out.push_back(makeKeyframe(k));
+    out.push_back(make_keyframe(k));
     last_emitted_t_ns = state.t_ns[k];
   }
 }
@@ -392,8 +392,8 @@ WindowEstimate SlidingWindowEstimator::Impl::process(const TrackedFrame& frame, 
     last_fail_reason = why;
     if (was_tracking) spdlog::warn("estimator reset at t={:.3f} s: {}", frame.t_ns * 1e-9, why);
     else if (!repeat) spdlog::info("frame at t={:.3f} s not estimated (not initialised): {}", frame.t_ns * 1e-9, why);
-    if (was_tracking && latest_slot > 0) emitKeyframes(latest_slot, e.finished_keyframes);
-    resetAll();
+    if (was_tracking && latest_slot > 0) emit_keyframes(latest_slot, e.finished_keyframes);
+    reset_all();
     e.status = was_tracking ? EstimatorStatus::Reset : EstimatorStatus::Initializing;
     e.event = was_tracking ? "reset: " + why : repeat ? std::string() : "not initialised: " + why;
     return finish(e);
@@ -412,22 +412,22 @@ WindowEstimate SlidingWindowEstimator::Impl::process(const TrackedFrame& frame, 
   slot_image[newest] = frame.image;  // shallow copy, released when the frame leaves the window
   if (newest > 0) {
     std::string why;
-    if (!predictNewest(*imu, &why)) return fail(why, newest - 1);
+    if (!predict_newest(*imu, &why)) return fail(why, newest - 1);
   }
   last_fail_reason.clear();  // this frame is in: the next failure is a new event
   const Eigen::Vector3d last_p = newest > 0 ? Eigen::Vector3d(state.p(newest - 1)) : Eigen::Vector3d::Zero();
   const Eigen::Quaterniond last_q = newest > 0 ? state.q(newest - 1) : Eigen::Quaterniond::Identity();
   const bool keep_second_newest =
-      features.addFrame(newest, frame, opt.keyframe_parallax / kNominalFocalPx, mode.stereo);
+      features.add_frame(newest, frame, opt.keyframe_parallax / kNominalFocalPx, mode.stereo);
 
   if (!tracking) {
     if (mode.stereo) {
-      if (newest > 0) pnpNewest();  // from points triangulated in earlier frames
+      if (newest > 0) pnp_newest();  // from points triangulated in earlier frames
       features.triangulate(cams(), T_c0c1, true);
     }
     if (newest < W) return finish(e);  // still filling the window
     std::string why;
-    const bool ok = mode.stereo ? initializeStereo(&why) : initializeMonoWindow(&why);
+    const bool ok = mode.stereo ? initialize_stereo(&why) : initialize_mono_window(&why);
     if (!ok) {
       // Each new reason once at info (a standing camera would otherwise say the same every frame).
       if (why != last_init_failure) spdlog::info("not initialised yet at t={:.3f} s: {}", frame.t_ns * 1e-9, why);
@@ -442,18 +442,18 @@ WindowEstimate SlidingWindowEstimator::Impl::process(const TrackedFrame& frame, 
     tracking = true;
     e.event = "initialized";
     spdlog::info("estimator initialised at t={:.3f} s ({} mode, {} BA)", frame.t_ns * 1e-9,
-                 mode.stereo ? "stereo" : "mono", toString(mode.loss));
+                 mode.stereo ? "stereo" : "mono", to_string(mode.loss));
   } else {
     // At rest? Judged on the IMU-predicted rotation and the last solve's weights and speed, before this solve.
     const Eigen::Matrix3d R_prev_new = state.camera(newest - 1).R.transpose() * state.camera(newest).R;
     const StandstillCheck rest =
-        checkStandstill(features, newest, R_prev_new, state.v(newest - 1).norm(), standstillOptions(opt));
+        check_standstill(features, newest, R_prev_new, state.v(newest - 1).norm(), standstill_options(opt));
     state.still[newest] = rest.still ? 1 : 0;
     e.standstill = rest.still;
     features.triangulate(cams(), T_c0c1, mode.stereo);
     e.solve = optimizer.solve(state, newest, features);
-    features.removeBadDepths();
-    const std::string why = failureReason(last_p, last_q);
+    features.remove_bad_depths();
+    const std::string why = failure_reason(last_p, last_q);
     if (!why.empty()) return fail(why, -1);
   }
   spdlog::debug("t={:.3f} p=({:.3f},{:.3f},{:.3f}) v=({:.3f},{:.3f},{:.3f}) ba={:.3f} bg={:.4f} ba_ms={:.1f} it={} alt={} feats={} kf={} still={}",
@@ -462,9 +462,9 @@ WindowEstimate SlidingWindowEstimator::Impl::process(const TrackedFrame& frame, 
                 e.solve.ceres_iterations, e.solve.alternations, e.solve.features_in_window, keep_second_newest,
                 e.standstill);
   e.keyframe = keep_second_newest;
-  fillOutput(e);
+  fill_output(e);
   // The oldest keyframe leaves the window now, with its final pose and the features before they go.
-  if (keep_second_newest) emitKeyframes(1, e.finished_keyframes);
+  if (keep_second_newest) emit_keyframes(1, e.finished_keyframes);
   const auto t_m = Clock::now();
   slide(keep_second_newest);
   e.solve.marginalization_ms = std::chrono::duration<double, std::milli>(Clock::now() - t_m).count();
@@ -481,7 +481,7 @@ WindowEstimate SlidingWindowEstimator::process(const TrackedFrame& frame, const 
   return impl_->process(frame, imu);
 }
 
-NavState SlidingWindowEstimator::latestState() const {
+NavState SlidingWindowEstimator::latest_state() const {
   NavState s;
   const Impl& m = *impl_;
   if (m.newest < 0) return s;
@@ -496,10 +496,10 @@ NavState SlidingWindowEstimator::latestState() const {
   return s;
 }
 
-std::vector<Keyframe> SlidingWindowEstimator::flushKeyframes() {
+std::vector<Keyframe> SlidingWindowEstimator::flush_keyframes() {
   std::vector<Keyframe> out;
   Impl& m = *impl_;
-  if (m.tracking && m.newest > 0) m.emitKeyframes(m.newest, out);
+  if (m.tracking && m.newest > 0) m.emit_keyframes(m.newest, out);
   return out;
 }
 

@@ -23,7 +23,7 @@ struct EstimatorMode {
 
 /// Keyframes for the loop closer (paper IV, DESIGN.md §2): every frame the window kept is handed out once,
 /// as a dynavins::Keyframe with its final window pose, when it leaves the window as the marginalised
-/// oldest keyframe (WindowEstimate::finished_keyframes), or at the end of the run (flushKeyframes()).
+/// oldest keyframe (WindowEstimate::finished_keyframes), or at the end of the run (flush_keyframes()).
 /// Its points are the window features it observed (p_w from the feature's current depth, when it has one;
 /// weight w_j, 1 under huber), its image the tracked frame's left image (shallow: the window holds one
 /// image reference per slot, released when the frame leaves). Only frames whose pose is tracking-valid
@@ -42,11 +42,11 @@ class SlidingWindowEstimator {
   WindowEstimate process(const TrackedFrame& frame, const PreintegratedInterval* imu);
 
   /// The newest frame's state (for IMU-rate propagation); valid once tracking.
-  NavState latestState() const;
+  NavState latest_state() const;
   /// The keyframes still in the window (every slot but the newest frame, which no keyframe decision has
   /// kept yet), oldest first, none already handed out; empty unless tracking. For the end of the run: a
   /// later process() does not hand them out again.
-  std::vector<Keyframe> flushKeyframes();
+  std::vector<Keyframe> flush_keyframes();
   bool tracking() const;
 
  private:

@@ -5,13 +5,13 @@
 
 namespace dynavins::estimator {
 
-StandstillCheck checkStandstill(const WindowFeatures& features, int newest, const Eigen::Matrix3d& R_prev_new,
+StandstillCheck check_standstill(const WindowFeatures& features, int newest, const Eigen::Matrix3d& R_prev_new,
                                 double speed, const StandstillOptions& options) {
   StandstillCheck c;
   if (newest < 1) return c;
   std::vector<double> disparity;
   for (const auto& [id, f] : features.all()) {
-    if (f.endSlot() != newest || f.start_slot > newest - 1 || f.weight < options.min_weight) continue;
+    if (f.end_slot() != newest || f.start_slot > newest - 1 || f.weight < options.min_weight) continue;
     const Eigen::Vector2d& xy_prev = f.obs[newest - 1 - f.start_slot].xy;
     const Eigen::Vector2d& xy_new = f.obs.back().xy;
     // The newest bearing seen from the previous camera's orientation: what is left is translation (or

@@ -32,7 +32,7 @@ struct StandstillCheck {
 
 /// Tests slot `newest` against slot `newest - 1`. `R_prev_new` rotates cam0 of the newest frame into cam0 of
 /// the previous one (from the IMU-predicted states); `speed` is |v| of the previous frame [m/s].
-StandstillCheck checkStandstill(const WindowFeatures& features, int newest, const Eigen::Matrix3d& R_prev_new,
+StandstillCheck check_standstill(const WindowFeatures& features, int newest, const Eigen::Matrix3d& R_prev_new,
                                 double speed, const StandstillOptions& options);
 
 }  // namespace dynavins::estimator

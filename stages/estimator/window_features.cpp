@@ -4,7 +4,7 @@
 
 namespace dynavins::estimator {
 
-bool WindowFeatures::addFrame(int slot, const TrackedFrame& frame, double min_parallax, bool use_right) {
+bool WindowFeatures::add_frame(int slot, const TrackedFrame& frame, double min_parallax, bool use_right) {
   int tracked = 0, long_tracks = 0, new_features = 0;
   for (const TrackedFeature& tf : frame.features) {
     FeatureObservation o;
@@ -14,7 +14,7 @@ bool WindowFeatures::addFrame(int slot, const TrackedFrame& frame, double min_pa
     o.xy_right = tf.xy_right;
     o.px_right = tf.px_right;
     auto it = features_.find(tf.id);
-    if (it == features_.end() || it->second.endSlot() != slot - 1) {
+    if (it == features_.end() || it->second.end_slot() != slot - 1) {
       // New to the window (or a gap in its track, which ids never have): anchor it here.
       WindowFeature f;
       f.id = tf.id;
@@ -38,7 +38,7 @@ bool WindowFeatures::addFrame(int slot, const TrackedFrame& frame, double min_pa
   double sum = 0;
   int n = 0;
   for (const auto& [id, f] : features_) {
-    if (f.start_slot <= slot - 2 && f.endSlot() >= slot - 1) {
+    if (f.start_slot <= slot - 2 && f.end_slot() >= slot - 1) {
       const auto& a = f.obs[slot - 2 - f.start_slot].xy;
       const auto& b = f.obs[slot - 1 - f.start_slot].xy;
       sum += (a - b).norm();
@@ -49,7 +49,7 @@ bool WindowFeatures::addFrame(int slot, const TrackedFrame& frame, double min_pa
   return sum / n >= min_parallax;
 }
 
-Eigen::Vector3d triangulateTwoView(const CameraPose& c0, const CameraPose& c1, const Eigen::Vector2d& x0,
+Eigen::Vector3d triangulate_two_view(const CameraPose& c0, const CameraPose& c1, const Eigen::Vector2d& x0,
                                    const Eigen::Vector2d& x1) {
   // Rows x * P3 - P1 and y * P3 - P2 of each camera's projection P = [R^T | -R^T p].
   auto projection = [](const CameraPose& c) {
@@ -75,9 +75,9 @@ void WindowFeatures::triangulate(const SlotCameraPose& cam, const Eigen::Isometr
     Eigen::Vector3d p_w;
     if (use_right && f.obs[0].has_right) {
       const CameraPose c1{c0.R * T_c0c1.linear(), c0.p + c0.R * T_c0c1.translation()};
-      p_w = triangulateTwoView(c0, c1, f.obs[0].xy, f.obs[0].xy_right);
+      p_w = triangulate_two_view(c0, c1, f.obs[0].xy, f.obs[0].xy_right);
     } else if (f.obs.size() >= 2) {
-      p_w = triangulateTwoView(c0, cam(f.start_slot + 1), f.obs[0].xy, f.obs[1].xy);
+      p_w = triangulate_two_view(c0, cam(f.start_slot + 1), f.obs[0].xy, f.obs[1].xy);
     } else {
       continue;
     }
@@ -101,7 +101,7 @@ void WindowFeatures::reanchor(WindowFeature& f, const CameraPose& old_anchor, co
   }
 }
 
-void WindowFeatures::removeOldest(const SlotCameraPose& cam) {
+void WindowFeatures::remove_oldest(const SlotCameraPose& cam) {
   const CameraPose c0 = cam(0), c1 = cam(1);
   for (auto it = features_.begin(); it != features_.end();) {
     WindowFeature& f = it->second;
@@ -118,7 +118,7 @@ void WindowFeatures::removeOldest(const SlotCameraPose& cam) {
   }
 }
 
-void WindowFeatures::removeSlot(int slot, const SlotCameraPose& cam) {
+void WindowFeatures::remove_slot(int slot, const SlotCameraPose& cam) {
   for (auto it = features_.begin(); it != features_.end();) {
     WindowFeature& f = it->second;
     if (f.start_slot > slot) {
@@ -130,14 +130,14 @@ void WindowFeatures::removeSlot(int slot, const SlotCameraPose& cam) {
       }
       reanchor(f, cam(slot), cam(slot + 1));
       f.obs.erase(f.obs.begin());  // the next observation is now the anchor, at the same slot index
-    } else if (f.endSlot() >= slot) {
+    } else if (f.end_slot() >= slot) {
       f.obs.erase(f.obs.begin() + (slot - f.start_slot));
     }
     ++it;
   }
 }
 
-int WindowFeatures::removeBadDepths() {
+int WindowFeatures::remove_bad_depths() {
   int n = 0;
   for (auto it = features_.begin(); it != features_.end();) {
     if (it->second.has_depth && !(it->second.inv_depth > 0)) {

@@ -36,13 +36,13 @@ struct WindowFeature {
   double inv_depth = 0;                 ///< 1 / z in the anchor's cam0; the BA's parameter block
   bool has_depth = false;
   double weight = 1.0;       ///< w_j (paper eq. 10), the weight the run reports and scores
-  double state_weight = 1.0;  ///< ŵ_j = stateStepWeight(w_j), the value the reprojection factors read
+  double state_weight = 1.0;  ///< ŵ_j = state_step_weight(w_j), the value the reprojection factors read
   double weight_prev = 1.0;  ///< w̄_j: weight after the previous window solve
   int times_solved = 0;      ///< n_j
   int8_t sim_label = -1;     ///< simulator label at the latest observation (scoring only)
 
-  int endSlot() const { return start_slot + static_cast<int>(obs.size()) - 1; }
-  bool inBa() const { return has_depth && static_cast<int>(obs.size()) >= kMinObservationsInBa; }
+  int end_slot() const { return start_slot + static_cast<int>(obs.size()) - 1; }
+  bool in_ba() const { return has_depth && static_cast<int>(obs.size()) >= kMinObservationsInBa; }
 };
 
 /// cam0 pose in the world of a window slot: (R_wc, p_wc).
@@ -58,7 +58,7 @@ class WindowFeatures {
   /// frame (slot - 1) should stay as a keyframe (VINS' addFeatureCheckParallax): early in the window,
   /// few tracked or long tracks, many new features, or average parallax between slots slot-2 and slot-1
   /// of at least `min_parallax` (on the z = 1 plane).
-  bool addFrame(int slot, const TrackedFrame& frame, double min_parallax, bool use_right);
+  bool add_frame(int slot, const TrackedFrame& frame, double min_parallax, bool use_right);
 
   /// Sets depths of features without one: stereo triangulation in the anchor slot when it has a right
   /// observation, else two-view triangulation from the first two observations (>= 2 needed).
@@ -69,19 +69,19 @@ class WindowFeatures {
   /// their first observation and are re-anchored at the next (depth carried over through the world
   /// point); features left without observations are erased. Every slot index shifts down by one.
   /// `cam` gives the poses of the slots BEFORE the shift.
-  void removeOldest(const SlotCameraPose& cam);
+  void remove_oldest(const SlotCameraPose& cam);
   /// Drops slot `slot` (the second newest, not kept as keyframe): its observations go, later slots shift
   /// down by one; a feature anchored there is re-anchored at the following slot.
-  void removeSlot(int slot, const SlotCameraPose& cam);
+  void remove_slot(int slot, const SlotCameraPose& cam);
 
   /// Erases features whose depth became invalid in the solve (behind the camera); returns how many.
-  int removeBadDepths();
+  int remove_bad_depths();
   void clear() { features_.clear(); }
 
   std::map<int64_t, WindowFeature>& all() { return features_; }
   const std::map<int64_t, WindowFeature>& all() const { return features_; }
-  /// Features of the latest addFrame that were already in the window.
-  int lastTrackedCount() const { return last_track_num_; }
+  /// Features of the latest add_frame that were already in the window.
+  int last_tracked_count() const { return last_track_num_; }
 
  private:
   void reanchor(WindowFeature& f, const CameraPose& old_anchor, const CameraPose& new_anchor) const;
@@ -92,7 +92,7 @@ class WindowFeatures {
 
 /// Linear (DLT) two-view triangulation of normalized observations x0, x1 with camera poses in a
 /// common frame: (R0, p0), (R1, p1) camera-to-frame. Returns the point in that frame.
-Eigen::Vector3d triangulateTwoView(const CameraPose& c0, const CameraPose& c1, const Eigen::Vector2d& x0,
+Eigen::Vector3d triangulate_two_view(const CameraPose& c0, const CameraPose& c1, const Eigen::Vector2d& x0,
                                    const Eigen::Vector2d& x1);
 
 }  // namespace dynavins::estimator

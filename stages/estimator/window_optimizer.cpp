@@ -22,7 +22,7 @@ namespace dynavins::estimator {
 namespace {
 
 using Clock = std::chrono::steady_clock;
-double msSince(Clock::time_point t0) {
+double ms_since(Clock::time_point t0) {
   return std::chrono::duration<double, std::milli>(Clock::now() - t0).count();
 }
 
@@ -35,7 +35,7 @@ struct VisualResidual {
 };
 
 /// Every reprojection residual of `f` (paper III-D: the same-frame stereo residual is never weighted).
-std::vector<VisualResidual> visualResiduals(WindowState& s, WindowFeature& f, const WindowSolveOptions& o) {
+std::vector<VisualResidual> visual_residuals(WindowState& s, WindowFeature& f, const WindowSolveOptions& o) {
   std::vector<VisualResidual> out;
   const bool dyn = o.loss == BaLoss::Dynavins;
   const double* w = dyn ? &f.state_weight : nullptr;  // ŵ_j (feature_weights.hpp)
@@ -67,18 +67,18 @@ std::vector<VisualResidual> visualResiduals(WindowState& s, WindowFeature& f, co
 /// dynavins mode the paper's weights replace it (eq. 4) unless `weighted_huber` keeps it under them: a
 /// weight judges a whole track, the Huber loss bounds a single bad observation of a track still kept
 /// (sim, stereo: e_shape ATE 0.31 -> 0.08 m, temporal_static 1.19 -> 0.85 m, the rest within 0.04 m; README).
-std::shared_ptr<ceres::LossFunction> lossFor(const VisualResidual& r, const WindowSolveOptions& o) {
+std::shared_ptr<ceres::LossFunction> loss_for(const VisualResidual& r, const WindowSolveOptions& o) {
   // One stateless loss shared by every residual (Ceres does not own it here), not one per residual.
-  static const auto huber = std::make_shared<ceres::HuberLoss>(1.0);
+  static const auto kHuber = std::make_shared<ceres::HuberLoss>(1.0);
   if (o.loss == BaLoss::Dynavins && r.weighted && !o.weighted_huber) return nullptr;
-  return huber;
+  return kHuber;
 }
 
-bool imuUsable(const WindowState& s, int k) { return s.preint[k] && s.preint[k]->sumDt() < 10.0; }
+bool imu_usable(const WindowState& s, int k) { return s.preint[k] && s.preint[k]->sum_dt() < 10.0; }
 
 }  // namespace
 
-bool WindowOptimizer::marginalizeOrDrop(MarginalizationInfo& info) {
+bool WindowOptimizer::marginalize_or_drop(MarginalizationInfo& info) {
   try {
     info.marginalize();
     return true;
@@ -119,15 +119,15 @@ struct FeatureGeometry {
     if (p_c.z() <= 1e-3) return Eigen::Vector2d(1e2, 1e2);  // behind the camera: as bad as it gets
     return sqrt_info * (p_c.head<2>() / p_c.z() - o.xy);
   }
-  /// r_j of feature_weights.hpp over the weighted observations (featureResidualScale).
-  double weightedMean(double rho, const FeatureWeightParams& p) const {
+  /// r_j of feature_weights.hpp over the weighted observations (feature_residual_scale).
+  double weighted_mean(double rho, const FeatureWeightParams& p) const {
     std::vector<double> sq;
     for (const Obs& o : obs)
       if (o.weighted) sq.push_back(residual(o, rho).squaredNorm());
-    return featureResidualScale(sq, p);
+    return feature_residual_scale(sq, p);
   }
   /// Inverse depth that best explains every observation with the poses fixed (1-D Gauss-Newton).
-  double bestInverseDepth(double rho) const {
+  double best_inverse_depth(double rho) const {
     for (int it = 0; it < 5; ++it) {
       const double h = 1e-6 * std::max(rho, 1e-3);
       double H = 0, b = 0;
@@ -146,9 +146,9 @@ struct FeatureGeometry {
   }
 };
 
-/// featureResidual() with the camera poses from `camera(slot, cam)` and `g` as reusable scratch.
+/// feature_residual() with the camera poses from `camera(slot, cam)` and `g` as reusable scratch.
 template <typename CameraOf>
-double featureResidualWith(const WindowFeature& f, const WindowSolveOptions& opt, const CameraOf& camera,
+double feature_residual_with(const WindowFeature& f, const WindowSolveOptions& opt, const CameraOf& camera,
                            FeatureGeometry& g) {
   // r_j is measured at the depth that best explains all the feature's observations with the poses
   // fixed, not at the BA's current depth: once a feature's weight is low, the unweighted stereo
@@ -166,14 +166,14 @@ double featureResidualWith(const WindowFeature& f, const WindowSolveOptions& opt
     if (k > 0) g.obs.push_back({camera(j, 0), f.obs[k].xy, true});
     if (opt.stereo && f.obs[k].has_right) g.obs.push_back({camera(j, 1), f.obs[k].xy_right, k > 0});
   }
-  return g.weightedMean(g.bestInverseDepth(f.inv_depth), opt.weights);
+  return g.weighted_mean(g.best_inverse_depth(f.inv_depth), opt.weights);
 }
 
 }  // namespace
 
-double WindowOptimizer::featureResidual(const WindowState& s, const WindowFeature& f) const {
+double WindowOptimizer::feature_residual(const WindowState& s, const WindowFeature& f) const {
   FeatureGeometry g;
-  return featureResidualWith(f, opt_, [&s](int k, int c) { return s.camera(k, c); }, g);
+  return feature_residual_with(f, opt_, [&s](int k, int c) { return s.camera(k, c); }, g);
 }
 
 namespace {
@@ -186,12 +186,12 @@ class WindowProblem {
  public:
   WindowProblem(WindowState& s, int newest, WindowFeatures& features, const WindowSolveOptions& opt,
                 const std::shared_ptr<MarginalizationInfo>& prior, const std::vector<double*>& prior_blocks)
-      : problem_(problemOptions()) {
-    addStates(s, newest, opt);
-    if (prior) addCost(std::make_shared<MarginalizationFactor>(prior), nullptr, prior_blocks);
-    addImu(s, newest, opt);
-    addZeroVelocity(s, newest, opt);
-    addVisual(s, newest, features, opt);
+      : problem_(problem_options()) {
+    add_states(s, newest, opt);
+    if (prior) add_cost(std::make_shared<MarginalizationFactor>(prior), nullptr, prior_blocks);
+    add_imu(s, newest, opt);
+    add_zero_velocity(s, newest, opt);
+    add_visual(s, newest, features, opt);
   }
   WindowProblem(const WindowProblem&) = delete;
   WindowProblem& operator=(const WindowProblem&) = delete;
@@ -201,7 +201,7 @@ class WindowProblem {
   const std::vector<WindowFeature*>& features() const { return in_ba_; }
 
  private:
-  static ceres::Problem::Options problemOptions() {
+  static ceres::Problem::Options problem_options() {
     ceres::Problem::Options po;
     po.cost_function_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
     po.loss_function_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
@@ -212,14 +212,14 @@ class WindowProblem {
     return po;
   }
 
-  void addCost(std::shared_ptr<ceres::CostFunction> cost, ceres::LossFunction* loss,
+  void add_cost(std::shared_ptr<ceres::CostFunction> cost, ceres::LossFunction* loss,
                const std::vector<double*>& blocks) {
     problem_.AddResidualBlock(cost.get(), loss, blocks);
     costs_.push_back(std::move(cost));
   }
 
   /// Pose and speed-bias of every slot; the camera extrinsics, fixed from config.
-  void addStates(WindowState& s, int newest, const WindowSolveOptions& opt) {
+  void add_states(WindowState& s, int newest, const WindowSolveOptions& opt) {
     for (int k = 0; k <= newest; ++k) {
       problem_.AddParameterBlock(s.pose[k].data(), kPoseSize, &pose_manifold_);
       problem_.AddParameterBlock(s.speed_bias[k].data(), kSpeedBiasSize);
@@ -231,28 +231,28 @@ class WindowProblem {
   }
 
   /// Preintegrated IMU between consecutive slots (the inertial term of eq. 1).
-  void addImu(WindowState& s, int newest, const WindowSolveOptions& opt) {
+  void add_imu(WindowState& s, int newest, const WindowSolveOptions& opt) {
     for (int k = 1; k <= newest; ++k) {
-      if (!imuUsable(s, k)) continue;
-      addCost(std::make_shared<ImuFactor>(s.preint[k].get(), opt.gravity), nullptr,
+      if (!imu_usable(s, k)) continue;
+      add_cost(std::make_shared<ImuFactor>(s.preint[k].get(), opt.gravity), nullptr,
               {s.pose[k - 1].data(), s.speed_bias[k - 1].data(), s.pose[k].data(), s.speed_bias[k].data()});
     }
   }
 
   /// Zero velocity on the slots found at rest (standstill_detector.hpp; not in the paper).
-  void addZeroVelocity(WindowState& s, int newest, const WindowSolveOptions& opt) {
+  void add_zero_velocity(WindowState& s, int newest, const WindowSolveOptions& opt) {
     for (int k = 0; k <= newest; ++k) {
       if (!s.still[k]) continue;
-      addCost(std::make_shared<ZeroVelocityFactor>(opt.zero_velocity_sigma), nullptr, {s.speed_bias[k].data()});
+      add_cost(std::make_shared<ZeroVelocityFactor>(opt.zero_velocity_sigma), nullptr, {s.speed_bias[k].data()});
     }
   }
 
-  /// Reprojection residuals (the visual term of eq. 1; weighted by w_j in eq. 11, see lossFor for the loss).
-  void addVisual(WindowState& s, int newest, WindowFeatures& features, const WindowSolveOptions& opt) {
+  /// Reprojection residuals (the visual term of eq. 1; weighted by w_j in eq. 11, see loss_for for the loss).
+  void add_visual(WindowState& s, int newest, WindowFeatures& features, const WindowSolveOptions& opt) {
     for (auto& [id, f] : features.all()) {
-      if (!f.inBa() || f.start_slot > newest) continue;
+      if (!f.in_ba() || f.start_slot > newest) continue;
       in_ba_.push_back(&f);
-      for (VisualResidual& r : visualResiduals(s, f, opt)) addCost(r.cost, lossFor(r, opt).get(), r.blocks);
+      for (VisualResidual& r : visual_residuals(s, f, opt)) add_cost(r.cost, loss_for(r, opt).get(), r.blocks);
     }
   }
 
@@ -289,7 +289,7 @@ class StateSolver {
     ++st_.alternations;
     return summary.termination_type == ceres::CONVERGENCE;
   }
-  int iterationsLeft() const { return budget_; }
+  int iterations_left() const { return budget_; }
   bool exhausted() const { return budget_ <= 0 || !(time_left_ > 0); }
 
  private:
@@ -300,7 +300,7 @@ class StateSolver {
   double time_left_;
 };
 
-/// The weight step (paper eq. 10 in closed form, solveFeatureWeight) with the states fixed.
+/// The weight step (paper eq. 10 in closed form, solve_feature_weight) with the states fixed.
 class WeightStep {
  public:
   WeightStep(const WindowState& s, int newest, const WindowSolveOptions& opt, SolveStats& st)
@@ -315,13 +315,13 @@ class WeightStep {
     auto camera = [this](int k, int c) -> const CameraPose& { return cameras_[k][c]; };
     int settled = 0;
     for (WindowFeature* f : features) {
-      const double r = featureResidualWith(*f, opt_, camera, geometry_);
-      const double w = solveFeatureWeight(r, f->weight_prev, f->times_solved, opt_.weights);
+      const double r = feature_residual_with(*f, opt_, camera, geometry_);
+      const double w = solve_feature_weight(r, f->weight_prev, f->times_solved, opt_.weights);
       if (std::abs(w - f->weight) < opt_.settle_tolerance) ++settled;
       f->weight = w;
-      f->state_weight = stateStepWeight(w, opt_.weights);
+      f->state_weight = state_step_weight(w, opt_.weights);
     }
-    st_.weight_ms += msSince(t0);
+    st_.weight_ms += ms_since(t0);
     return features.empty() ? 1.0 : static_cast<double>(settled) / features.size();
   }
 
@@ -346,7 +346,7 @@ void alternate(const WindowState& s, int newest, const std::vector<WindowFeature
   weight_step(features);
   for (int a = 0; a < opt.max_alternations && !solver.exhausted(); ++a) {
     const bool last = a + 1 == opt.max_alternations;
-    const int budget = solver.iterationsLeft();
+    const int budget = solver.iterations_left();
     const bool converged = solver.run(last ? budget : std::max(2, budget / 2));
     const double settled = weight_step(features);
     if (settled >= opt.alternating_converge && converged) break;
@@ -369,14 +369,14 @@ SolveStats WindowOptimizer::solve(WindowState& s, int newest, WindowFeatures& fe
   if (opt_.loss == BaLoss::Dynavins) {
     alternate(s, newest, window.features(), opt_, solver, st);
   } else {
-    solver.run(solver.iterationsLeft());  // eq. 1, Huber loss on the visual residuals
+    solver.run(solver.iterations_left());  // eq. 1, Huber loss on the visual residuals
   }
   gauge.restore(s, newest);
-  st.ba_ms = msSince(t_ba);
+  st.ba_ms = ms_since(t_ba);
   return st;
 }
 
-void WindowOptimizer::marginalizeOldest(WindowState& s, int newest, WindowFeatures& features) {
+void WindowOptimizer::marginalize_oldest(WindowState& s, int newest, WindowFeatures& features) {
   auto info = std::make_shared<MarginalizationInfo>();
   double* pose0 = s.pose[0].data();
   double* sb0 = s.speed_bias[0].data();
@@ -387,33 +387,33 @@ void WindowOptimizer::marginalizeOldest(WindowState& s, int newest, WindowFeatur
     }
     info->add({std::make_shared<MarginalizationFactor>(prior_), nullptr, prior_blocks_, drop});
   }
-  if (imuUsable(s, 1)) {
+  if (imu_usable(s, 1)) {
     info->add({std::make_shared<ImuFactor>(s.preint[1].get(), opt_.gravity), nullptr,
                {pose0, sb0, s.pose[1].data(), s.speed_bias[1].data()}, {0, 1}});
   }
   if (s.still[0]) info->add({std::make_shared<ZeroVelocityFactor>(opt_.zero_velocity_sigma), nullptr, {sb0}, {0}});
   for (auto& [id, f] : features.all()) {
-    if (f.start_slot != 0 || !f.inBa()) continue;
+    if (f.start_slot != 0 || !f.in_ba()) continue;
     // A feature the robust BA rejected would poison the prior forever (paper III; margin_feature_thresh).
     if (opt_.loss == BaLoss::Dynavins && f.weight < opt_.margin_feature_thresh) continue;
-    for (VisualResidual& r : visualResiduals(s, f, opt_)) {
+    for (VisualResidual& r : visual_residuals(s, f, opt_)) {
       std::vector<int> drop{static_cast<int>(r.blocks.size()) - 1};  // the inverse depth
       if (r.anchor_block >= 0) drop.push_back(r.anchor_block);
-      info->add({r.cost, lossFor(r, opt_), r.blocks, drop});
+      info->add({r.cost, loss_for(r, opt_), r.blocks, drop});
     }
   }
   info->linearize();  // evaluates now, while the features' weights are alive
-  if (!marginalizeOrDrop(*info)) return;
+  if (!marginalize_or_drop(*info)) return;
   std::unordered_map<const double*, double*> shift;
   for (int k = 1; k <= newest; ++k) {
     shift[s.pose[k].data()] = s.pose[k - 1].data();
     shift[s.speed_bias[k].data()] = s.speed_bias[k - 1].data();
   }
-  prior_blocks_ = info->keptBlocks(shift);
+  prior_blocks_ = info->kept_blocks(shift);
   prior_ = info;
 }
 
-void WindowOptimizer::marginalizeSecondNewest(WindowState& s, int newest) {
+void WindowOptimizer::marginalize_second_newest(WindowState& s, int newest) {
   if (!prior_) return;
   double* pose_drop = s.pose[newest - 1].data();
   std::vector<int> drop;
@@ -424,11 +424,11 @@ void WindowOptimizer::marginalizeSecondNewest(WindowState& s, int newest) {
   auto info = std::make_shared<MarginalizationInfo>();
   info->add({std::make_shared<MarginalizationFactor>(prior_), nullptr, prior_blocks_, drop});
   info->linearize();
-  if (!marginalizeOrDrop(*info)) return;
+  if (!marginalize_or_drop(*info)) return;
   std::unordered_map<const double*, double*> shift;
   shift[s.pose[newest].data()] = s.pose[newest - 1].data();
   shift[s.speed_bias[newest].data()] = s.speed_bias[newest - 1].data();
-  prior_blocks_ = info->keptBlocks(shift);
+  prior_blocks_ = info->kept_blocks(shift);
   prior_ = info;
 }
 

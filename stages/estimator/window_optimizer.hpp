@@ -46,24 +46,24 @@ class WindowOptimizer {
   SolveStats solve(WindowState& s, int newest, WindowFeatures& features);
 
   /// Marginalises slot 0 (the oldest keyframe) into the prior; call before the window slides.
-  void marginalizeOldest(WindowState& s, int newest, WindowFeatures& features);
+  void marginalize_oldest(WindowState& s, int newest, WindowFeatures& features);
   /// Marginalises the second-newest slot's pose out of the prior (its measurements are dropped, as in
   /// VINS-Fusion); call before that slot is removed.
-  void marginalizeSecondNewest(WindowState& s, int newest);
+  void marginalize_second_newest(WindowState& s, int newest);
 
   void reset();
-  bool hasPrior() const { return prior_ != nullptr; }
+  bool has_prior() const { return prior_ != nullptr; }
   /// The marginalisation prior the next solve uses (null when there is none); read-only (tests).
   const MarginalizationInfo* prior() const { return prior_.get(); }
   const WindowSolveOptions& options() const { return opt_; }
 
   /// Mean whitened squared reprojection residual of a feature over its weighted observations (the r_j
   /// of feature_weights.hpp) at the current states.
-  double featureResidual(const WindowState& s, const WindowFeature& f) const;
+  double feature_residual(const WindowState& s, const WindowFeature& f) const;
 
  private:
   /// Runs the Schur step; when no information is left, drops the prior (logged) and returns false.
-  bool marginalizeOrDrop(MarginalizationInfo& info);
+  bool marginalize_or_drop(MarginalizationInfo& info);
 
   WindowSolveOptions opt_;
   std::shared_ptr<MarginalizationInfo> prior_;

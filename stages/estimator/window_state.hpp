@@ -43,7 +43,7 @@ struct WindowState {
   }
 
   /// Copies every state of slot `from` into slot `to` (preintegration moved).
-  void moveSlot(int from, int to) {
+  void move_slot(int from, int to) {
     t_ns[to] = t_ns[from];
     pose[to] = pose[from];
     speed_bias[to] = speed_bias[from];
@@ -55,7 +55,7 @@ struct WindowState {
   std::vector<std::array<double, kPoseSize>> pose;
   std::vector<std::array<double, kSpeedBiasSize>> speed_bias;
   std::array<std::array<double, kPoseSize>, 2> extrinsic{};  ///< body_T_cam0, body_T_cam1
-  std::vector<std::unique_ptr<ImuPreintegration>> preint;   ///< preint[k]: slot k-1 -> k (null at slot 0)
+  std::vector<std::unique_ptr<imu::ImuPreintegration>> preint;   ///< preint[k]: slot k-1 -> k (null at slot 0)
   std::vector<uint8_t> still;  ///< 1: slot k was found at rest (standstill_detector.hpp); its velocity is held at 0
 };
 

@@ -8,11 +8,11 @@
 
 #include "stages/imu/imu_preintegration.hpp"
 
-namespace dynavins {
+namespace dynavins::imu {
 
-void appendInterval(PreintegratedInterval& first, const PreintegratedInterval& later) {
+void append_interval(PreintegratedInterval& first, const PreintegratedInterval& later) {
   if (later.t_begin_ns != first.t_end_ns)
-    throw std::invalid_argument("appendInterval: interval starting at " + std::to_string(later.t_begin_ns) +
+    throw std::invalid_argument("append_interval: interval starting at " + std::to_string(later.t_begin_ns) +
                                 " ns does not continue one ending at " + std::to_string(first.t_end_ns) + " ns");
   const std::vector<ImuSample>& s = later.preint.samples;
   // s[0] is later's start, interpolated at the shared frame time: first already ends with it.
@@ -25,7 +25,7 @@ void appendInterval(PreintegratedInterval& first, const PreintegratedInterval& l
   first.num_raw_samples += later.num_raw_samples;
 }
 
-std::vector<FrameWithImu> FrameImuPairer::addFrame(TrackedFrame frame) {
+std::vector<FrameWithImu> FrameImuPairer::add_frame(TrackedFrame frame) {
   if (last_frame_in_ns_ && frame.t_ns <= *last_frame_in_ns_) {
     ++stats_.frames_out_of_order;
     spdlog::warn("FrameImuPairer: frame at {} ns ignored (not after {} ns)", frame.t_ns, *last_frame_in_ns_);
@@ -37,7 +37,7 @@ std::vector<FrameWithImu> FrameImuPairer::addFrame(TrackedFrame frame) {
   return drain();
 }
 
-std::vector<FrameWithImu> FrameImuPairer::addInterval(PreintegratedInterval interval) {
+std::vector<FrameWithImu> FrameImuPairer::add_interval(PreintegratedInterval interval) {
   if (interval.t_end_ns <= interval.t_begin_ns ||
       (last_interval_end_ns_ && interval.t_begin_ns < *last_interval_end_ns_)) {
     ++stats_.intervals_out_of_order;
@@ -117,7 +117,7 @@ std::vector<FrameWithImu> FrameImuPairer::drain() {
     PreintegratedInterval merged = std::move(intervals_.front());
     intervals_.pop_front();
     for (std::size_t i = 0; i < k; ++i) {
-      appendInterval(merged, intervals_.front());
+      append_interval(merged, intervals_.front());
       intervals_.pop_front();
     }
     stats_.merged_intervals += static_cast<int64_t>(k);
@@ -126,4 +126,4 @@ std::vector<FrameWithImu> FrameImuPairer::drain() {
   return out;
 }
 
-}  // namespace dynavins
+}  // namespace dynavins::imu

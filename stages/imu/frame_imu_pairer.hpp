@@ -23,7 +23,7 @@
 #include "messages/tracked_frame.hpp"
 #include "messages/preintegrated_interval.hpp"
 
-namespace dynavins {
+namespace dynavins::imu {
 
 /// A tracked frame and the IMU over (previous emitted frame time, frame.t_ns]; no IMU for the first frame.
 struct FrameWithImu {
@@ -49,20 +49,20 @@ struct FrameImuPairerStats {
 /// Merges `later` (which must start where `first` ends) into `first`: the deltas continue with later's
 /// samples after its first one (first's interpolated end), gap flags OR-ed, raw sample counts summed.
 /// Throws std::invalid_argument when the two are not contiguous.
-void appendInterval(PreintegratedInterval& first, const PreintegratedInterval& later);
+void append_interval(PreintegratedInterval& first, const PreintegratedInterval& later);
 
 class FrameImuPairer {
  public:
   /// A tracked frame in; returns the frames that became ready (in time order).
-  std::vector<FrameWithImu> addFrame(TrackedFrame frame);
+  std::vector<FrameWithImu> add_frame(TrackedFrame frame);
   /// An interval in; returns the frames that became ready (in time order).
-  std::vector<FrameWithImu> addInterval(PreintegratedInterval interval);
+  std::vector<FrameWithImu> add_interval(PreintegratedInterval interval);
   /// End of both streams: counts the frames still waiting as unpaired (logged), emits nothing.
   void finish();
 
   const FrameImuPairerStats& stats() const { return stats_; }
   /// Frames waiting for their IMU.
-  std::size_t waitingFrames() const { return frames_.size(); }
+  std::size_t waiting_frames() const { return frames_.size(); }
 
  private:
   std::vector<FrameWithImu> drain();
@@ -75,4 +75,4 @@ class FrameImuPairer {
   FrameImuPairerStats stats_;
 };
 
-}  // namespace dynavins
+}  // namespace dynavins::imu

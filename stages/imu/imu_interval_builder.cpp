@@ -9,7 +9,7 @@
 #include "stages/imu/imu_preintegration.hpp"
 #include "stages/imu/imu_sample_interpolation.hpp"
 
-namespace dynavins {
+namespace dynavins::imu {
 
 ImuIntervalBuilder::ImuIntervalBuilder(ImuIntervalBuilderOptions options) : opt_(std::move(options)) {
   if (!(opt_.imu_rate_hz > 0.0) || !(opt_.gap_periods >= 1.0))
@@ -17,12 +17,12 @@ ImuIntervalBuilder::ImuIntervalBuilder(ImuIntervalBuilderOptions options) : opt_
   gap_threshold_ns_ = std::llround(opt_.gap_periods * 1e9 / opt_.imu_rate_hz);
 }
 
-void ImuIntervalBuilder::setBiases(const Eigen::Vector3d& ba, const Eigen::Vector3d& bg) {
+void ImuIntervalBuilder::set_biases(const Eigen::Vector3d& ba, const Eigen::Vector3d& bg) {
   ba_ = ba;
   bg_ = bg;
 }
 
-std::vector<PreintegratedInterval> ImuIntervalBuilder::addImu(const ImuSample& s) {
+std::vector<PreintegratedInterval> ImuIntervalBuilder::add_imu(const ImuSample& s) {
   if (!imu_.empty() && s.t_ns <= imu_.back().t_ns) {
     ++stats_.imu_rejected_out_of_order;
     spdlog::debug("ImuIntervalBuilder: IMU sample at {} ns rejected (last {} ns)", s.t_ns, imu_.back().t_ns);
@@ -32,7 +32,7 @@ std::vector<PreintegratedInterval> ImuIntervalBuilder::addImu(const ImuSample& s
   return drain();
 }
 
-std::vector<PreintegratedInterval> ImuIntervalBuilder::addFrame(int64_t t_ns) {
+std::vector<PreintegratedInterval> ImuIntervalBuilder::add_frame(int64_t t_ns) {
   if (have_frame_ && t_ns <= last_frame_ns_) {
     ++stats_.frames_rejected_out_of_order;
     spdlog::warn("ImuIntervalBuilder: frame at {} ns rejected (last {} ns)", t_ns, last_frame_ns_);
@@ -100,4 +100,4 @@ void ImuIntervalBuilder::trim() {
   while (imu_.size() > opt_.max_buffered_samples) imu_.pop_front();
 }
 
-}  // namespace dynavins
+}  // namespace dynavins::imu

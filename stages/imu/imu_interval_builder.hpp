@@ -17,7 +17,7 @@
 #include "stages/imu/imu_noise_params.hpp"
 #include "messages/preintegrated_interval.hpp"
 
-namespace dynavins {
+namespace dynavins::imu {
 
 /// Settings of ImuIntervalBuilder.
 struct ImuIntervalBuilderOptions {
@@ -41,17 +41,17 @@ class ImuIntervalBuilder {
   explicit ImuIntervalBuilder(ImuIntervalBuilderOptions options = {});
 
   /// Sets the linearisation biases for intervals built from now on (the estimator's latest estimate).
-  void setBiases(const Eigen::Vector3d& ba, const Eigen::Vector3d& bg);
+  void set_biases(const Eigen::Vector3d& ba, const Eigen::Vector3d& bg);
 
   /// Adds an IMU sample; returns the intervals it completes (possibly none). Rejects (and counts) samples
   /// not strictly after the last accepted one.
-  std::vector<PreintegratedInterval> addImu(const ImuSample& s);
+  std::vector<PreintegratedInterval> add_imu(const ImuSample& s);
   /// Adds a frame time; returns the intervals that can be completed now. Rejects (and counts) times not
   /// strictly after the last accepted frame.
-  std::vector<PreintegratedInterval> addFrame(int64_t t_ns);
+  std::vector<PreintegratedInterval> add_frame(int64_t t_ns);
 
   /// Gap threshold in use [ns].
-  int64_t gapThresholdNs() const { return gap_threshold_ns_; }
+  int64_t gap_threshold_ns() const { return gap_threshold_ns_; }
   /// Rejection counters.
   const ImuIntervalBuilderStats& stats() const { return stats_; }
 
@@ -70,4 +70,4 @@ class ImuIntervalBuilder {
   int64_t last_frame_ns_ = 0;
 };
 
-}  // namespace dynavins
+}  // namespace dynavins::imu

@@ -7,11 +7,11 @@
 // For an IMU with continuous-time (Kalibr) densities σ_a [m/s²/√Hz], σ_ba [m/s³/√Hz] sampled every dt, the
 // true growth is Var(δβ) += σ_a²·dt (each sample is shared by two midpoint steps, so the midpoint model's
 // independent-endpoint assumption halves it) and Var(δba) += σ_ba²·dt. Matching the two gives
-// fromContinuousDensities() below; the Monte Carlo test in tests/imu checks this mapping.
+// from_continuous_densities() below; the Monte Carlo test in tests/imu checks this mapping.
 
 #include <cmath>
 
-namespace dynavins {
+namespace dynavins::imu {
 
 /// IMU noise in VINS-Fusion's yaml convention (see the file comment for the exact meaning).
 struct ImuNoiseParams {
@@ -23,7 +23,7 @@ struct ImuNoiseParams {
   /// Values that make VINS-Fusion's propagation reproduce, to first order, the covariance of an IMU with
   /// continuous-time densities (Kalibr convention) sampled at period dt_s:
   /// acc_n = σ_a·√(2/dt), gyr_n = σ_g·√(2/dt), acc_w = σ_ba/√dt, gyr_w = σ_bg/√dt.
-  static ImuNoiseParams fromContinuousDensities(double acc_noise_density, double gyr_noise_density,
+  static ImuNoiseParams from_continuous_densities(double acc_noise_density, double gyr_noise_density,
                                                 double acc_random_walk, double gyr_random_walk, double dt_s) {
     ImuNoiseParams p;
     p.acc_n = acc_noise_density * std::sqrt(2.0 / dt_s);
@@ -34,4 +34,4 @@ struct ImuNoiseParams {
   }
 };
 
-}  // namespace dynavins
+}  // namespace dynavins::imu

@@ -6,14 +6,14 @@
 
 #include "stages/common/so3.hpp"
 
-namespace dynavins {
+namespace dynavins::imu {
 namespace {
 
-using so3::rightJacobian;  // Exp(φ + δ) ≈ Exp(φ) Exp(Jr(φ) δ) (Forster et al. 2017, §II-A)
+using so3::right_jacobian;  // Exp(φ + δ) ≈ Exp(φ) Exp(Jr(φ) δ) (Forster et al. 2017, §II-A)
 
 // Exact quaternion exponential; VINS uses the first-order (1, θ/2) form, equal to first order, so the
 // Jacobians below are unchanged while large rates lose no accuracy.
-Eigen::Quaterniond expQ(const Eigen::Vector3d& theta) {
+Eigen::Quaterniond exp_q(const Eigen::Vector3d& theta) {
   const double a = theta.norm();
   if (a < 1e-12) return Eigen::Quaterniond(1.0, 0.5 * theta.x(), 0.5 * theta.y(), 0.5 * theta.z()).normalized();
   return Eigen::Quaterniond(Eigen::AngleAxisd(a, theta / a));
@@ -82,22 +82,22 @@ void ImuPreintegration::integrate(const ImuSample& s) {
                                 " ns not after " + std::to_string(samples_.back().t_ns) + " ns");
   const ImuSample prev = samples_.back();
   samples_.push_back(s);
-  midpointStep(prev, s);
+  midpoint_step(prev, s);
 }
 
 void ImuPreintegration::repropagate(const Eigen::Vector3d& ba, const Eigen::Vector3d& bg) {
   ba_ = ba;
   bg_ = bg;
   reset();
-  for (size_t k = 1; k < samples_.size(); ++k) midpointStep(samples_[k - 1], samples_[k]);
+  for (size_t k = 1; k < samples_.size(); ++k) midpoint_step(samples_[k - 1], samples_[k]);
 }
 
-void ImuPreintegration::midpointStep(const ImuSample& s0, const ImuSample& s1) {
+void ImuPreintegration::midpoint_step(const ImuSample& s0, const ImuSample& s1) {
   const double dt = static_cast<double>(s1.t_ns - s0.t_ns) * 1e-9;
   // Midpoint mean propagation (VINS-Mono §IV-B discretised with the midpoint rule, as IntegrationBase does).
   const Eigen::Vector3d a0 = s0.acc - ba_, a1 = s1.acc - ba_;
   const Eigen::Vector3d w = 0.5 * (s0.gyr + s1.gyr) - bg_;
-  const Eigen::Quaterniond dq = expQ(w * dt);
+  const Eigen::Quaterniond dq = exp_q(w * dt);
   const Eigen::Quaterniond g1 = (gamma_ * dq).normalized();
   const Eigen::Matrix3d R0 = gamma_.toRotationMatrix(), R1 = g1.toRotationMatrix();
   const Eigen::Vector3d acc = 0.5 * (R0 * a0 + R1 * a1);
@@ -112,7 +112,7 @@ void ImuPreintegration::midpointStep(const ImuSample& s0, const ImuSample& s1) {
   const Eigen::Matrix3d I = Eigen::Matrix3d::Identity();
   const Eigen::Matrix3d Ra0 = R0 * so3::hat(a0), Ra1 = R1 * so3::hat(a1);
   const Eigen::Matrix3d dRt = dq.toRotationMatrix().transpose();
-  const Eigen::Matrix3d Jr = rightJacobian(w * dt);
+  const Eigen::Matrix3d Jr = right_jacobian(w * dt);
   const double dt2 = dt * dt;
   Matrix15 F = Matrix15::Identity();
   F.block<3, 3>(kP, kR) = -0.25 * (Ra0 + Ra1 * dRt) * dt2;
@@ -148,28 +148,28 @@ void ImuPreintegration::midpointStep(const ImuSample& s0, const ImuSample& s1) {
   sum_dt_ += dt;
 }
 
-bool ImuPreintegration::biasMovedFar(const Eigen::Vector3d& ba, const Eigen::Vector3d& bg, double ba_threshold,
+bool ImuPreintegration::bias_moved_far(const Eigen::Vector3d& ba, const Eigen::Vector3d& bg, double ba_threshold,
                                      double bg_threshold) const {
   return (ba - ba_).norm() > ba_threshold || (bg - bg_).norm() > bg_threshold;
 }
 
-void ImuPreintegration::correctedDeltas(const Eigen::Vector3d& ba, const Eigen::Vector3d& bg,
+void ImuPreintegration::corrected_deltas(const Eigen::Vector3d& ba, const Eigen::Vector3d& bg,
                                         Eigen::Vector3d& alpha, Eigen::Quaterniond& gamma,
                                         Eigen::Vector3d& beta) const {
   const Eigen::Vector3d dba = ba - ba_, dbg = bg - bg_;
   // Δ(b) ≈ Δ(b̄) + J δb, rotation through Exp (Forster §VI-C; VINS-Mono §IV-B).
   alpha = alpha_ + jacobian_.block<3, 3>(kP, kBa) * dba + jacobian_.block<3, 3>(kP, kBg) * dbg;
   beta = beta_ + jacobian_.block<3, 3>(kV, kBa) * dba + jacobian_.block<3, 3>(kV, kBg) * dbg;
-  gamma = (gamma_ * expQ(jacobian_.block<3, 3>(kR, kBg) * dbg)).normalized();
+  gamma = (gamma_ * exp_q(jacobian_.block<3, 3>(kR, kBg) * dbg)).normalized();
 }
 
-ImuPreintegration::Vector15 ImuPreintegration::evaluateResidual(
+ImuPreintegration::Vector15 ImuPreintegration::evaluate_residual(
     const Eigen::Vector3d& Pi, const Eigen::Quaterniond& Qi, const Eigen::Vector3d& Vi, const Eigen::Vector3d& Bai,
     const Eigen::Vector3d& Bgi, const Eigen::Vector3d& Pj, const Eigen::Quaterniond& Qj, const Eigen::Vector3d& Vj,
     const Eigen::Vector3d& Baj, const Eigen::Vector3d& Bgj, double gravity) const {
   Eigen::Vector3d alpha, beta;
   Eigen::Quaterniond gamma;
-  correctedDeltas(Bai, Bgi, alpha, gamma, beta);
+  corrected_deltas(Bai, Bgi, alpha, gamma, beta);
   const Eigen::Vector3d g_w(0.0, 0.0, -gravity);
   const double T = sum_dt_;
   const Eigen::Quaterniond Qi_inv = Qi.conjugate();
@@ -183,4 +183,4 @@ ImuPreintegration::Vector15 ImuPreintegration::evaluateResidual(
   return r;
 }
 
-}  // namespace dynavins
+}  // namespace dynavins::imu

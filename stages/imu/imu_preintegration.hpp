@@ -16,7 +16,7 @@
 #include "messages/sensor_messages.hpp"
 #include "stages/imu/imu_noise_params.hpp"
 
-namespace dynavins {
+namespace dynavins::imu {
 
 /// Preintegrated IMU measurements between two instants, with covariance and bias Jacobian.
 class ImuPreintegration {
@@ -45,36 +45,36 @@ class ImuPreintegration {
 
   /// True when |ba - linearised ba| > ba_threshold or |bg - linearised bg| > bg_threshold: the first-order
   /// correction is no longer trustworthy and repropagate() should be called.
-  bool biasMovedFar(const Eigen::Vector3d& ba, const Eigen::Vector3d& bg, double ba_threshold,
+  bool bias_moved_far(const Eigen::Vector3d& ba, const Eigen::Vector3d& bg, double ba_threshold,
                     double bg_threshold) const;
 
   /// Deltas corrected to first order for biases (ba, bg) (Forster §VI-C; VINS-Mono §IV-B).
-  void correctedDeltas(const Eigen::Vector3d& ba, const Eigen::Vector3d& bg, Eigen::Vector3d& alpha,
+  void corrected_deltas(const Eigen::Vector3d& ba, const Eigen::Vector3d& bg, Eigen::Vector3d& alpha,
                        Eigen::Quaterniond& gamma, Eigen::Vector3d& beta) const;
 
   /// The 15-dim residual between states i and j (VINS-Mono §VI-B; IntegrationBase::evaluate), with world
   /// gravity g_w = (0, 0, -gravity): [r_p, r_θ, r_v, r_ba, r_bg], deltas bias-corrected with (Bai, Bgi).
-  Vector15 evaluateResidual(const Eigen::Vector3d& Pi, const Eigen::Quaterniond& Qi, const Eigen::Vector3d& Vi,
+  Vector15 evaluate_residual(const Eigen::Vector3d& Pi, const Eigen::Quaterniond& Qi, const Eigen::Vector3d& Vi,
                             const Eigen::Vector3d& Bai, const Eigen::Vector3d& Bgi, const Eigen::Vector3d& Pj,
                             const Eigen::Quaterniond& Qj, const Eigen::Vector3d& Vj, const Eigen::Vector3d& Baj,
                             const Eigen::Vector3d& Bgj, double gravity = 9.81) const;
 
-  const Eigen::Vector3d& deltaP() const { return alpha_; }    ///< α: position delta in frame i
-  const Eigen::Quaterniond& deltaQ() const { return gamma_; } ///< γ: rotation from frame j to frame i
-  const Eigen::Vector3d& deltaV() const { return beta_; }     ///< β: velocity delta in frame i
+  const Eigen::Vector3d& delta_p() const { return alpha_; }    ///< α: position delta in frame i
+  const Eigen::Quaterniond& delta_q() const { return gamma_; } ///< γ: rotation from frame j to frame i
+  const Eigen::Vector3d& delta_v() const { return beta_; }     ///< β: velocity delta in frame i
   const Matrix15& covariance() const { return covariance_; }  ///< covariance of the error state
   const Matrix15& jacobian() const { return jacobian_; }      ///< d(error state at j)/d(error state at i)
-  double sumDt() const { return sum_dt_; }                    ///< interval length [s]
-  int64_t tBeginNs() const { return t_begin_ns_; }            ///< time of the first sample
-  int64_t tEndNs() const { return samples_.empty() ? t_begin_ns_ : samples_.back().t_ns; }  ///< last sample
-  const Eigen::Vector3d& linearizedBa() const { return ba_; } ///< accelerometer bias of linearisation
-  const Eigen::Vector3d& linearizedBg() const { return bg_; } ///< gyroscope bias of linearisation
+  double sum_dt() const { return sum_dt_; }                    ///< interval length [s]
+  int64_t t_begin_ns() const { return t_begin_ns_; }            ///< time of the first sample
+  int64_t t_end_ns() const { return samples_.empty() ? t_begin_ns_ : samples_.back().t_ns; }  ///< last sample
+  const Eigen::Vector3d& linearized_ba() const { return ba_; } ///< accelerometer bias of linearisation
+  const Eigen::Vector3d& linearized_bg() const { return bg_; } ///< gyroscope bias of linearisation
   const std::vector<ImuSample>& samples() const { return samples_; }  ///< raw samples, first included
   const ImuNoiseParams& noise() const { return noise_; }              ///< noise parameters in use
 
  private:
   void reset();
-  void midpointStep(const ImuSample& s0, const ImuSample& s1);
+  void midpoint_step(const ImuSample& s0, const ImuSample& s1);
 
   std::vector<ImuSample> samples_;
   ImuNoiseParams noise_;
@@ -88,4 +88,4 @@ class ImuPreintegration {
   int64_t t_begin_ns_ = 0;
 };
 
-}  // namespace dynavins
+}  // namespace dynavins::imu

@@ -4,7 +4,7 @@
 
 #include "stages/imu/imu_sample_interpolation.hpp"
 
-namespace dynavins {
+namespace dynavins::imu {
 
 ImuPropagator::ImuPropagator(ImuPropagatorOptions options) : opt_(options) {}
 
@@ -29,7 +29,7 @@ void ImuPropagator::reset(const NavState& state) {
     if (s.t_ns > state.t_ns) step(s);
 }
 
-std::optional<NavState> ImuPropagator::addImu(const ImuSample& s) {
+std::optional<NavState> ImuPropagator::add_imu(const ImuSample& s) {
   if (!history_.empty() && s.t_ns <= history_.back().t_ns) {
     ++rejected_;
     return std::nullopt;
@@ -68,4 +68,4 @@ void ImuPropagator::step(const ImuSample& s) {
   have_last_ = true;
 }
 
-}  // namespace dynavins
+}  // namespace dynavins::imu

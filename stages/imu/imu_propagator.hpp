@@ -11,7 +11,7 @@
 #include "messages/estimate_messages.hpp"
 #include "messages/sensor_messages.hpp"
 
-namespace dynavins {
+namespace dynavins::imu {
 
 /// Settings of ImuPropagator.
 struct ImuPropagatorOptions {
@@ -30,13 +30,13 @@ class ImuPropagator {
   void reset(const NavState& state);
 
   /// Adds a sample; returns the state propagated to its time, or nothing before the first reset() or
-  /// for a sample not after the previous one (counted in rejectedSamples()).
-  std::optional<NavState> addImu(const ImuSample& s);
+  /// for a sample not after the previous one (counted in rejected_samples()).
+  std::optional<NavState> add_imu(const ImuSample& s);
 
   /// Latest propagated state (nothing before the first reset()).
   std::optional<NavState> latest() const;
   /// Samples rejected for not being strictly after the previous one.
-  int64_t rejectedSamples() const { return rejected_; }
+  int64_t rejected_samples() const { return rejected_; }
 
  private:
   void step(const ImuSample& s);
@@ -50,4 +50,4 @@ class ImuPropagator {
   int64_t rejected_ = 0;
 };
 
-}  // namespace dynavins
+}  // namespace dynavins::imu

@@ -6,7 +6,7 @@
 
 #include "messages/sensor_messages.hpp"
 
-namespace dynavins {
+namespace dynavins::imu {
 
 /// The measurements at t, a.t_ns <= t <= b.t_ns and a.t_ns < b.t_ns; exactly a or b at the ends.
 inline ImuSample interpolate(const ImuSample& a, const ImuSample& b, int64_t t) {
@@ -20,4 +20,4 @@ inline ImuSample interpolate(const ImuSample& a, const ImuSample& b, int64_t t) 
   return s;
 }
 
-}  // namespace dynavins
+}  // namespace dynavins::imu

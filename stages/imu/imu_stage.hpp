@@ -14,7 +14,7 @@
 #include "stages/imu/imu_interval_builder.hpp"
 #include "messages/preintegrated_interval.hpp"
 
-namespace dynavins {
+namespace dynavins::imu {
 
 /// The capture time of one source frame: where an IMU interval ends and the next begins.
 struct FrameTime {
@@ -28,7 +28,7 @@ using ImuStageInput = std::variant<ImuSample, FrameTime>;
 enum class ImuNoiseConvention {
   /// Used as given, exactly as VINS-Fusion's IntegrationBase does (its configs are tuned for this).
   VinsFusion,
-  /// Continuous-time (Kalibr) densities, mapped with ImuNoiseParams::fromContinuousDensities at imu_rate_hz.
+  /// Continuous-time (Kalibr) densities, mapped with ImuNoiseParams::from_continuous_densities at imu_rate_hz.
   ContinuousDensity,
 };
 
@@ -49,7 +49,7 @@ struct ImuStageStats {
   int64_t imu_samples = 0;   ///< IMU samples received
   int64_t frame_times = 0;   ///< frame times received
   int64_t intervals = 0;     ///< intervals emitted
-  int64_t bias_updates = 0;  ///< setBiases() calls that changed the biases
+  int64_t bias_updates = 0;  ///< set_biases() calls that changed the biases
 };
 
 class ImuStage {
@@ -60,11 +60,11 @@ class ImuStage {
   std::vector<PreintegratedInterval> process(const ImuStageInput& input);
 
   /// Linearisation biases for intervals built from now on (the estimator's latest estimate).
-  void setBiases(const Eigen::Vector3d& ba, const Eigen::Vector3d& bg);
+  void set_biases(const Eigen::Vector3d& ba, const Eigen::Vector3d& bg);
 
   const ImuStageStats& stats() const { return stats_; }
   /// Rejected input and gap counters of the interval builder.
-  const ImuIntervalBuilderStats& builderStats() const { return builder_.stats(); }
+  const ImuIntervalBuilderStats& builder_stats() const { return builder_.stats(); }
 
  private:
   ImuIntervalBuilder builder_;
@@ -72,4 +72,4 @@ class ImuStage {
   Eigen::Vector3d ba_ = Eigen::Vector3d::Zero(), bg_ = Eigen::Vector3d::Zero();
 };
 
-}  // namespace dynavins
+}  // namespace dynavins::imu

@@ -6,7 +6,7 @@
 #include <opencv2/core/hal/intrin.hpp>
 #include <opencv2/imgproc.hpp>
 
-namespace dynavins {
+namespace dynavins::tracker {
 
 namespace {
 
@@ -173,4 +173,4 @@ std::vector<cv::Point2f> detect_corners(const cv::Mat& gray, const cv::Mat& mask
   return out;
 }
 
-}  // namespace dynavins
+}  // namespace dynavins::tracker

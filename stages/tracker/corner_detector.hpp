@@ -8,7 +8,7 @@
 
 #include <opencv2/core/mat.hpp>
 
-namespace dynavins {
+namespace dynavins::tracker {
 
 /// Buffers detect_corners reuses from call to call: they are image-sized, and fresh ones cost page
 /// faults on every call.
@@ -24,4 +24,4 @@ struct CornerScratch {
 std::vector<cv::Point2f> detect_corners(const cv::Mat& gray, const cv::Mat& mask, int max_corners, double quality,
                                         double min_distance, CornerScratch* scratch = nullptr);
 
-}  // namespace dynavins
+}  // namespace dynavins::tracker

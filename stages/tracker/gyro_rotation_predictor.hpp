@@ -17,7 +17,7 @@
 
 #include "messages/sensor_messages.hpp"
 
-namespace dynavins {
+namespace dynavins::tracker {
 
 class GyroRotationPredictor {
  public:
@@ -32,14 +32,14 @@ class GyroRotationPredictor {
                                          const Eigen::Vector3d& bias_gyr = Eigen::Vector3d::Zero()) const;
 
   /// The same in the body (IMU) frame: R_{b(t0) b(t1)}.
-  std::optional<Eigen::Matrix3d> predictBody(const std::vector<ImuSample>& imu, int64_t t0_ns, int64_t t1_ns,
+  std::optional<Eigen::Matrix3d> predict_body(const std::vector<ImuSample>& imu, int64_t t0_ns, int64_t t1_ns,
                                              const Eigen::Vector3d& bias_gyr = Eigen::Vector3d::Zero()) const;
 
-  int64_t maxGapNs() const { return max_gap_ns_; }
+  int64_t max_gap_ns() const { return max_gap_ns_; }
 
  private:
   Eigen::Matrix3d R_bc_;  // cam0 -> body rotation
   int64_t max_gap_ns_;
 };
 
-}  // namespace dynavins
+}  // namespace dynavins::tracker

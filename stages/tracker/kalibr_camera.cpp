@@ -6,7 +6,7 @@
 
 #include "stages/common/config_error.hpp"
 
-namespace dynavins {
+namespace dynavins::tracker {
 
 namespace {
 
@@ -60,4 +60,4 @@ KalibrCamera load_kalibr_camera(const std::string& path) {
   return out;
 }
 
-}  // namespace dynavins
+}  // namespace dynavins::tracker

@@ -8,7 +8,7 @@
 
 #include "stages/common/pinhole_radtan_camera.hpp"
 
-namespace dynavins {
+namespace dynavins::tracker {
 
 struct KalibrCamera {
   std::shared_ptr<const PinholeRadtanCamera> camera;
@@ -18,4 +18,4 @@ struct KalibrCamera {
 /// Loads `path`; throws ConfigError naming the file and key for a missing key or another model.
 KalibrCamera load_kalibr_camera(const std::string& path);
 
-}  // namespace dynavins
+}  // namespace dynavins::tracker

@@ -5,13 +5,13 @@
 
 #include <Eigen/LU>
 
-namespace dynavins {
+namespace dynavins::tracker {
 
 namespace {
 
-constexpr int R = PatchTemplate::kRadius;
-constexpr int N = PatchTemplate::kPixels;
-using PatchVector = Eigen::Matrix<float, N, 1>;
+constexpr int kR = PatchTemplate::kRadius;
+constexpr int kN = PatchTemplate::kPixels;
+using PatchVector = Eigen::Matrix<float, kN, 1>;
 
 /// Bilinear sample of an 8-bit image; the caller keeps (x, y) inside [0, cols-1) x [0, rows-1).
 inline float sample(const cv::Mat& img, float x, float y) {
@@ -24,7 +24,7 @@ inline float sample(const cv::Mat& img, float x, float y) {
 
 /// Whether every pixel of the patch warped by (A, t), grown by `margin` patch pixels, samples inside.
 bool inside(const cv::Mat& img, const Eigen::Matrix2f& A, const Eigen::Vector2f& t, int margin) {
-  const float e = static_cast<float>(R + margin);
+  const float e = static_cast<float>(kR + margin);
   for (float su : {-e, e})
     for (float sv : {-e, e}) {
       const Eigen::Vector2f p = A * Eigen::Vector2f(su, sv) + t;
@@ -37,14 +37,14 @@ bool inside(const cv::Mat& img, const Eigen::Matrix2f& A, const Eigen::Vector2f&
 float normalise(PatchVector* v) {
   v->array() -= v->mean();
   const float n = v->norm();
-  if (!(n > 1e-3f * std::sqrt(static_cast<float>(N)))) return 0.f;  // under ~0.001 gray level rms
+  if (!(n > 1e-3f * std::sqrt(static_cast<float>(kN)))) return 0.f;  // under ~0.001 gray level rms
   *v /= n;
   return n;
 }
 
 }  // namespace
 
-float imageNoiseSigma(const cv::Mat& gray) {
+float image_noise_sigma(const cv::Mat& gray) {
   if (gray.type() != CV_8UC1 || gray.rows < 3 || gray.cols < 3) return 0.f;
   // sum |I * M| over the interior, M = [1 -2 1; -2 4 -2; 1 -2 1]; every fourth row is plenty.
   double sum = 0;
@@ -65,13 +65,13 @@ float imageNoiseSigma(const cv::Mat& gray) {
 
 float AffineWarp::scale() const { return std::sqrt(std::abs(A.determinant())); }
 
-std::shared_ptr<const PatchTemplate> capturePatch(const cv::Mat& gray, const Eigen::Vector2f& px) {
+std::shared_ptr<const PatchTemplate> capture_patch(const cv::Mat& gray, const Eigen::Vector2f& px) {
   if (gray.type() != CV_8UC1 || !inside(gray, Eigen::Matrix2f::Identity(), px, 1)) return nullptr;
   // The patch with a one-pixel rim for the central-difference gradients.
-  constexpr int S = PatchTemplate::kSide + 2;
-  Eigen::Matrix<float, S, S, Eigen::RowMajor> big;
-  for (int v = 0; v < S; ++v)
-    for (int u = 0; u < S; ++u) big(v, u) = sample(gray, px.x() + static_cast<float>(u - R - 1), px.y() + static_cast<float>(v - R - 1));
+  constexpr int kS = PatchTemplate::kSide + 2;
+  Eigen::Matrix<float, kS, kS, Eigen::RowMajor> big;
+  for (int v = 0; v < kS; ++v)
+    for (int u = 0; u < kS; ++u) big(v, u) = sample(gray, px.x() + static_cast<float>(u - kR - 1), px.y() + static_cast<float>(v - kR - 1));
   PatchVector value;
   for (int v = 0; v < PatchTemplate::kSide; ++v)
     for (int u = 0; u < PatchTemplate::kSide; ++u) value(v * PatchTemplate::kSide + u) = big(v + 1, u + 1);
@@ -79,11 +79,11 @@ std::shared_ptr<const PatchTemplate> capturePatch(const cv::Mat& gray, const Eig
   if (norm == 0.f) return nullptr;
 
   auto t = std::make_shared<PatchTemplate>();
-  for (int v = -R; v <= R; ++v)
-    for (int u = -R; u <= R; ++u) {
-      const int k = (v + R) * PatchTemplate::kSide + (u + R);
-      const float gx = 0.5f * (big(v + R + 1, u + R + 2) - big(v + R + 1, u + R)) / norm;
-      const float gy = 0.5f * (big(v + R + 2, u + R + 1) - big(v + R, u + R + 1)) / norm;
+  for (int v = -kR; v <= kR; ++v)
+    for (int u = -kR; u <= kR; ++u) {
+      const int k = (v + kR) * PatchTemplate::kSide + (u + kR);
+      const float gx = 0.5f * (big(v + kR + 1, u + kR + 2) - big(v + kR + 1, u + kR)) / norm;
+      const float gy = 0.5f * (big(v + kR + 2, u + kR + 1) - big(v + kR, u + kR + 1)) / norm;
       const float fu = static_cast<float>(u), fv = static_cast<float>(v);
       // d T(W(x; p)) / dp at p = 0 for W(x; p) = (I + D) x + t, p = (t_x, t_y, D00, D01, D10, D11).
       t->steepest_descent.col(k) << gx, gy, gx * fu, gx * fv, gy * fu, gy * fv;
@@ -104,7 +104,7 @@ std::shared_ptr<const PatchTemplate> capturePatch(const cv::Mat& gray, const Eig
   return t;
 }
 
-RefineOutcome refinePatch(const PatchTemplate& tmpl, const cv::Mat& gray, AffineWarp* warp, float noise_sigma,
+RefineOutcome refine_patch(const PatchTemplate& tmpl, const cv::Mat& gray, AffineWarp* warp, float noise_sigma,
                           int max_iterations, float epsilon) {
   const Eigen::Map<const PatchVector> T(tmpl.value.data());
   PatchVector I;
@@ -116,10 +116,10 @@ RefineOutcome refinePatch(const PatchTemplate& tmpl, const cv::Mat& gray, Affine
       return out;
     }
     // Warp the current image onto the template grid, row by row.
-    for (int v = -R; v <= R; ++v) {
-      Eigen::Vector2f p = warp->A * Eigen::Vector2f(static_cast<float>(-R), static_cast<float>(v)) + warp->t;
+    for (int v = -kR; v <= kR; ++v) {
+      Eigen::Vector2f p = warp->A * Eigen::Vector2f(static_cast<float>(-kR), static_cast<float>(v)) + warp->t;
       const Eigen::Vector2f step = warp->A.col(0);
-      float* out = I.data() + (v + R) * PatchTemplate::kSide;
+      float* out = I.data() + (v + kR) * PatchTemplate::kSide;
       for (int u = 0; u < PatchTemplate::kSide; ++u, p += step) out[u] = sample(gray, p.x(), p.y());
     }
     if (normalise(&I) == 0.f) return out;
@@ -150,4 +150,4 @@ RefineOutcome refinePatch(const PatchTemplate& tmpl, const cv::Mat& gray, Affine
   return out;
 }
 
-}  // namespace dynavins
+}  // namespace dynavins::tracker

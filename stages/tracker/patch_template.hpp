@@ -17,7 +17,7 @@
 #include <Eigen/Core>
 #include <opencv2/core/mat.hpp>
 
-namespace dynavins {
+namespace dynavins::tracker {
 
 /// The first appearance of a feature: a (2r+1)^2 patch normalised to zero mean and unit norm, with
 /// its steepest-descent images and inverse Gauss-Newton Hessian for the affine warp.
@@ -40,7 +40,7 @@ struct AffineWarp {
 
 /// Captures the patch centred at `px` of an 8-bit gray image. Returns null when the patch (plus one
 /// pixel for gradients) leaves the image or is flat (no texture to align).
-std::shared_ptr<const PatchTemplate> capturePatch(const cv::Mat& gray, const Eigen::Vector2f& px);
+std::shared_ptr<const PatchTemplate> capture_patch(const cv::Mat& gray, const Eigen::Vector2f& px);
 
 enum class RefineResult { Converged, OutOfImage, Diverged };
 
@@ -54,14 +54,14 @@ struct RefineOutcome {
 
 /// Standard deviation of the image noise [gray levels] (Immerkaer, "Fast noise variance estimation",
 /// CVIU 1996: the mean absolute response of a Laplacian difference that cancels texture to first order).
-float imageNoiseSigma(const cv::Mat& gray);
+float image_noise_sigma(const cv::Mat& gray);
 
 /// Aligns `tmpl` with `gray` starting at `warp` (updated in place). Converged when an update moves the
 /// centre less than `epsilon` px, or less than the centre's standard deviation under image noise
 /// `noise_sigma` [gray levels] when that is larger, within `max_iterations`: a track whose first patch
 /// does not settle is one whose appearance changed beyond the affine model; OutOfImage when the warped patch leaves the
 /// image; Diverged otherwise (no convergence, or a degenerate warp).
-RefineOutcome refinePatch(const PatchTemplate& tmpl, const cv::Mat& gray, AffineWarp* warp, float noise_sigma = 0.f,
+RefineOutcome refine_patch(const PatchTemplate& tmpl, const cv::Mat& gray, AffineWarp* warp, float noise_sigma = 0.f,
                           int max_iterations = 10, float epsilon = 0.01f);
 
-}  // namespace dynavins
+}  // namespace dynavins::tracker

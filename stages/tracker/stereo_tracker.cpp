@@ -11,7 +11,7 @@
 
 #include "stages/tracker/corner_detector.hpp"
 
-namespace dynavins {
+namespace dynavins::tracker {
 
 namespace {
 
@@ -21,11 +21,11 @@ Eigen::Vector2d to_eigen(const cv::Point2f& p) { return {p.x, p.y}; }
 
 /// Keeps the elements of `v` whose `keep` flag is set, in order.
 template <typename T>
-void compact(std::vector<T>* v, const std::vector<uchar>& keep) {
+void compact(std::vector<T>& v, const std::vector<uchar>& keep) {
   std::size_t j = 0;
-  for (std::size_t i = 0; i < v->size(); ++i)
-    if (keep[i]) (*v)[j++] = (*v)[i];
-  v->resize(j);
+  for (std::size_t i = 0; i < v.size(); ++i)
+    if (keep[i]) v[j++] = v[i];
+  v.resize(j);
 }
 
 }  // namespace
@@ -59,11 +59,11 @@ cv::Mat StereoTracker::prepare(const cv::Mat& img, const char* which, int64_t t_
   return out;
 }
 
-void StereoTracker::pyramid(const cv::Mat& img, Pyramid* pyr) const {
+void StereoTracker::pyramid(const cv::Mat& img, Pyramid& pyr) const {
   // Built once per image and shared by the forward, backward and stereo KLT calls; into the levels
   // `pyr` already holds when their sizes match. Level 0 is always a copy: were it the caller's image
   // (OpenCV's default for a submatrix with room round it), the next build would write into it.
-  cv::buildOpticalFlowPyramid(img, *pyr, cv::Size(opt_.window, opt_.window), opt_.pyramid_levels, true,
+  cv::buildOpticalFlowPyramid(img, pyr, cv::Size(opt_.window, opt_.window), opt_.pyramid_levels, true,
                               cv::BORDER_REFLECT_101, cv::BORDER_CONSTANT, false);
 }
 
@@ -74,12 +74,12 @@ bool StereoTracker::in_border(const cv::Point2f& p, const cv::Size& size) const 
 
 std::vector<StereoTracker::Track> StereoTracker::track_temporal(const Pyramid& curr,
                                                                 const std::optional<Eigen::Matrix3d>& R_prev_curr,
-                                                                std::vector<cv::Point2f>* prev_px,
-                                                                TrackerStats* stats) const {
+                                                                std::vector<cv::Point2f>& prev_px,
+                                                                TrackerStats& stats) const {
   std::vector<Track> tracks = tracks_;
   const std::size_t n = tracks.size();
-  prev_px->resize(n);
-  for (std::size_t i = 0; i < n; ++i) (*prev_px)[i] = tracks[i].px;
+  prev_px.resize(n);
+  for (std::size_t i = 0; i < n; ++i) prev_px[i] = tracks[i].px;
   if (n == 0) return tracks;
   const cv::Size size = curr[0].size();
   const cv::Size win(opt_.window, opt_.window);
@@ -87,7 +87,7 @@ std::vector<StereoTracker::Track> StereoTracker::track_temporal(const Pyramid& c
   // No error output from the KLT calls (here and in match_stereo): nothing reads it, and OpenCV spends
   // a pass over each window on it.
 
-  std::vector<cv::Point2f> px = *prev_px;
+  std::vector<cv::Point2f> px = prev_px;
   std::vector<uchar> status(n, 0), predicted(n, 0);
   if (R_prev_curr) {
     // A pure rotation moves every pixel the same whatever its depth: a good start.
@@ -103,7 +103,7 @@ std::vector<StereoTracker::Track> StereoTracker::track_temporal(const Pyramid& c
     }
     // The whole pyramid from the prediction: the fine levels alone lose fast-moving objects, whose
     // image motion the camera's rotation does not explain.
-    cv::calcOpticalFlowPyrLK(prev_pyr_, curr, *prev_px, px, status, cv::noArray(), win, opt_.pyramid_levels, crit,
+    cv::calcOpticalFlowPyrLK(prev_pyr_, curr, prev_px, px, status, cv::noArray(), win, opt_.pyramid_levels, crit,
                              cv::OPTFLOW_USE_INITIAL_FLOW);
     // Retry the failures (and the unpredicted) from scratch with the whole pyramid.
     std::vector<std::size_t> redo;
@@ -111,7 +111,7 @@ std::vector<StereoTracker::Track> StereoTracker::track_temporal(const Pyramid& c
       if (!status[i] || !predicted[i]) redo.push_back(i);
     if (!redo.empty()) {
       std::vector<cv::Point2f> from(redo.size()), to;
-      for (std::size_t k = 0; k < redo.size(); ++k) from[k] = (*prev_px)[redo[k]];
+      for (std::size_t k = 0; k < redo.size(); ++k) from[k] = prev_px[redo[k]];
       std::vector<uchar> st;
       cv::calcOpticalFlowPyrLK(prev_pyr_, curr, from, to, st, cv::noArray(), win, opt_.pyramid_levels, crit);
       for (std::size_t k = 0; k < redo.size(); ++k) {
@@ -121,11 +121,11 @@ std::vector<StereoTracker::Track> StereoTracker::track_temporal(const Pyramid& c
       }
     }
   } else {
-    cv::calcOpticalFlowPyrLK(prev_pyr_, curr, *prev_px, px, status, cv::noArray(), win, opt_.pyramid_levels, crit);
+    cv::calcOpticalFlowPyrLK(prev_pyr_, curr, prev_px, px, status, cv::noArray(), win, opt_.pyramid_levels, crit);
   }
   for (std::size_t i = 0; i < n; ++i)
     if (status[i] && !in_border(px[i], size)) status[i] = 0;
-  for (std::size_t i = 0; i < n; ++i) stats->lost_flow += !status[i];
+  for (std::size_t i = 0; i < n; ++i) stats.lost_flow += !status[i];
 
   if (opt_.flow_back) {
     // Back from the new pixel, starting at the old one: a track that does not come home slid. Only
@@ -134,38 +134,38 @@ std::vector<StereoTracker::Track> StereoTracker::track_temporal(const Pyramid& c
     for (std::size_t i = 0; i < n; ++i)
       if (status[i]) alive.push_back(i);
     std::vector<cv::Point2f> from(alive.size()), back(alive.size());
-    for (std::size_t k = 0; k < alive.size(); ++k) from[k] = px[alive[k]], back[k] = (*prev_px)[alive[k]];
+    for (std::size_t k = 0; k < alive.size(); ++k) from[k] = px[alive[k]], back[k] = prev_px[alive[k]];
     std::vector<uchar> back_status;
     if (!alive.empty())
       cv::calcOpticalFlowPyrLK(curr, prev_pyr_, from, back, back_status, cv::noArray(), win,
                                std::min(1, opt_.pyramid_levels), crit, cv::OPTFLOW_USE_INITIAL_FLOW);
     for (std::size_t k = 0; k < alive.size(); ++k) {
-      if (!back_status[k] || distance(back[k], (*prev_px)[alive[k]]) > opt_.max_back_error) {
+      if (!back_status[k] || distance(back[k], prev_px[alive[k]]) > opt_.max_back_error) {
         status[alive[k]] = 0;
-        ++stats->lost_back;
+        ++stats.lost_back;
       }
     }
   }
   for (std::size_t i = 0; i < n; ++i) {
     tracks[i].px = px[i];
     tracks[i].length += 1;
-    stats->predicted += status[i] && predicted[i];
+    stats.predicted += status[i] && predicted[i];
   }
-  compact(&tracks, status);
+  compact(tracks, status);
   compact(prev_px, status);
   return tracks;
 }
 
-void StereoTracker::refine_with_patches(const cv::Mat& img, std::vector<Track>* tracks,
-                                        std::vector<cv::Point2f>* prev_px, TrackerStats* stats) const {
-  std::vector<uchar> keep(tracks->size(), 1);
-  const float noise_sigma = imageNoiseSigma(img);
-  for (std::size_t i = 0; i < tracks->size(); ++i) {
-    Track& t = (*tracks)[i];
+void StereoTracker::refine_with_patches(const cv::Mat& img, std::vector<Track>& tracks,
+                                        std::vector<cv::Point2f>& prev_px, TrackerStats& stats) const {
+  std::vector<uchar> keep(tracks.size(), 1);
+  const float noise_sigma = image_noise_sigma(img);
+  for (std::size_t i = 0; i < tracks.size(); ++i) {
+    Track& t = tracks[i];
     if (!t.patch) continue;
     AffineWarp w = t.warp;
     w.t = Eigen::Vector2f(t.px.x, t.px.y);
-    const RefineOutcome o = refinePatch(*t.patch, img, &w, noise_sigma);
+    const RefineOutcome o = refine_patch(*t.patch, img, &w, noise_sigma);
     const RefineResult r = o.result;
     if (r == RefineResult::OutOfImage) continue;  // near the border: keep the KLT answer as it is
     const cv::Point2f refined(w.t.x(), w.t.y());
@@ -174,52 +174,52 @@ void StereoTracker::refine_with_patches(const cv::Mat& img, std::vector<Track>* 
       // The first patch no longer settles (its look changed beyond an affine warp: occluded, seen from
       // too far round) or settles elsewhere (the KLT slid): the track cannot be trusted any longer.
       keep[i] = 0;
-      ++stats->lost_patch;
+      ++stats.lost_patch;
       continue;
     }
     t.px = refined;
     t.warp = w;
     const double s = w.scale();
     if (s > opt_.patch_recapture_scale || s < 1.0 / opt_.patch_recapture_scale) {
-      t.patch = capturePatch(img, w.t);
+      t.patch = capture_patch(img, w.t);
       t.warp = AffineWarp{};
-      ++stats->patch_recaptured;
+      ++stats.patch_recaptured;
     }
   }
   compact(tracks, keep);
   compact(prev_px, keep);
 }
 
-void StereoTracker::reject_with_f(std::vector<Track>* tracks, std::vector<cv::Point2f>* prev_px,
-                                  TrackerStats* stats) const {
-  if (tracks->size() < 8) return;
+void StereoTracker::reject_with_f(std::vector<Track>& tracks, std::vector<cv::Point2f>& prev_px,
+                                  TrackerStats& stats) const {
+  if (tracks.size() < 8) return;
   // On the undistorted plane scaled to a virtual 460 px focal length, so the threshold is in
   // pixels of an ideal camera whatever the lens (VINS-Fusion's rejectWithF).
   constexpr double kFocal = 460.0;
   const double cx = cam0_->width() / 2.0, cy = cam0_->height() / 2.0;
   std::vector<cv::Point2f> a, b;
-  for (std::size_t i = 0; i < tracks->size(); ++i) {
-    const Eigen::Vector2d p = cam0_->lift_normalized(to_eigen((*prev_px)[i]));
-    const Eigen::Vector3d& c = (*tracks)[i].bearing;
+  for (std::size_t i = 0; i < tracks.size(); ++i) {
+    const Eigen::Vector2d p = cam0_->lift_normalized(to_eigen(prev_px[i]));
+    const Eigen::Vector3d& c = tracks[i].bearing;
     a.emplace_back(static_cast<float>(kFocal * p.x() + cx), static_cast<float>(kFocal * p.y() + cy));
     b.emplace_back(static_cast<float>(kFocal * c.x() / c.z() + cx), static_cast<float>(kFocal * c.y() / c.z() + cy));
   }
   std::vector<uchar> inlier;
   cv::findFundamentalMat(a, b, cv::FM_RANSAC, opt_.f_threshold, 0.99, inlier);
-  if (inlier.size() != tracks->size()) return;  // degenerate: keep everything
-  for (uchar s : inlier) stats->lost_ransac += !s;
+  if (inlier.size() != tracks.size()) return;  // degenerate: keep everything
+  for (uchar s : inlier) stats.lost_ransac += !s;
   compact(tracks, inlier);
   compact(prev_px, inlier);
 }
 
-void StereoTracker::enforce_spacing_and_detect(const cv::Mat& img, std::vector<Track>* tracks,
-                                               std::vector<cv::Point2f>* prev_px, TrackerStats* stats) {
+void StereoTracker::enforce_spacing_and_detect(const cv::Mat& img, std::vector<Track>& tracks,
+                                               std::vector<cv::Point2f>& prev_px, TrackerStats& stats) {
   // Longest tracks claim their neighbourhood first (ties: the older id), so a crowding newcomer
   // gives way to a long-lived feature and not the reverse.
-  std::vector<std::size_t> order(tracks->size());
+  std::vector<std::size_t> order(tracks.size());
   std::iota(order.begin(), order.end(), 0);
   std::stable_sort(order.begin(), order.end(), [&](std::size_t i, std::size_t j) {
-    const Track &a = (*tracks)[i], &b = (*tracks)[j];
+    const Track &a = tracks[i], &b = tracks[j];
     return a.length != b.length ? a.length > b.length : a.id < b.id;
   });
   cv::Mat& mask = mask_;
@@ -229,16 +229,16 @@ void StereoTracker::enforce_spacing_and_detect(const cv::Mat& img, std::vector<T
   std::vector<Track> kept;
   std::vector<cv::Point2f> kept_prev;
   for (std::size_t i : order) {
-    const cv::Point2f& p = (*tracks)[i].px;
+    const cv::Point2f& p = tracks[i].px;
     if (static_cast<int>(kept.size()) >= opt_.max_cnt || mask.at<uchar>(cvRound(p.y), cvRound(p.x)) == 0) {
-      ++stats->lost_mask;
+      ++stats.lost_mask;
       continue;
     }
-    kept.push_back((*tracks)[i]);
-    kept_prev.push_back((*prev_px)[i]);
+    kept.push_back(tracks[i]);
+    kept_prev.push_back(prev_px[i]);
     if (radius > 0) cv::circle(mask, cv::Point(cvRound(p.x), cvRound(p.y)), radius, cv::Scalar(0), cv::FILLED);
   }
-  stats->tracked = static_cast<int>(kept.size());
+  stats.tracked = static_cast<int>(kept.size());
   const int wanted = opt_.max_cnt - static_cast<int>(kept.size());
   if (wanted > 0) {
     const std::vector<cv::Point2f> corners =
@@ -246,17 +246,17 @@ void StereoTracker::enforce_spacing_and_detect(const cv::Mat& img, std::vector<T
     for (const auto& c : corners) {
       if (!in_border(c, img.size())) continue;
       kept.push_back(Track{next_id_++, 1, c, cam0_->lift(to_eigen(c))});
-      if (opt_.patch_refine) kept.back().patch = capturePatch(img, Eigen::Vector2f(c.x, c.y));
+      if (opt_.patch_refine) kept.back().patch = capture_patch(img, Eigen::Vector2f(c.x, c.y));
       kept_prev.emplace_back(std::numeric_limits<float>::quiet_NaN(), 0.f);  // new: no velocity
-      ++stats->detected;
+      ++stats.detected;
     }
   }
-  *tracks = std::move(kept);
-  *prev_px = std::move(kept_prev);
+  tracks = std::move(kept);
+  prev_px = std::move(kept_prev);
 }
 
-void StereoTracker::match_stereo(const Pyramid& curr, const cv::Mat& right_in, std::vector<Track>* tracks,
-                                 TrackedFrame* out) {
+void StereoTracker::match_stereo(const Pyramid& curr, const cv::Mat& right_in, std::vector<Track>& tracks,
+                                 TrackedFrame& out) {
   cv::Mat right = right_in;
   const cv::Mat& left = curr[0];
   if (right.size() != left.size()) throw std::invalid_argument("StereoTracker: left and right sizes differ");
@@ -270,11 +270,11 @@ void StereoTracker::match_stereo(const Pyramid& curr, const cv::Mat& right_in, s
       right = right_scaled_;
     }
   }
-  pyramid(right, &right_pyr_);
+  pyramid(right, right_pyr_);
   const Pyramid& rpyr = right_pyr_;
   const cv::Size win(opt_.window, opt_.window);
   const cv::TermCriteria crit(cv::TermCriteria::COUNT | cv::TermCriteria::EPS, opt_.max_iterations, opt_.epsilon);
-  const std::size_t n = tracks->size();
+  const std::size_t n = tracks.size();
   std::vector<cv::Point2f> lpx(n), rpx(n), back;
   std::vector<uchar> st(n, 0), back_st;
   // Left -> right (no rectification, so no epipolar prior). A track matched in the last frame starts
@@ -287,7 +287,7 @@ void StereoTracker::match_stereo(const Pyramid& curr, const cv::Mat& right_in, s
   std::vector<std::size_t> seeded, unseeded;
   std::vector<uchar> searched(n, 1);
   for (std::size_t i = 0; i < n; ++i) {
-    Track& t = (*tracks)[i];
+    Track& t = tracks[i];
     lpx[i] = t.px;
     if (!std::isnan(t.stereo_offset.x)) {
       seeded.push_back(i);
@@ -303,7 +303,7 @@ void StereoTracker::match_stereo(const Pyramid& curr, const cv::Mat& right_in, s
     std::vector<cv::Point2f> from(idx.size()), to(idx.size());
     for (std::size_t k = 0; k < idx.size(); ++k) {
       from[k] = lpx[idx[k]];
-      to[k] = from_offset ? from[k] + (*tracks)[idx[k]].stereo_offset : from[k];
+      to[k] = from_offset ? from[k] + tracks[idx[k]].stereo_offset : from[k];
     }
     std::vector<uchar> s;
     cv::calcOpticalFlowPyrLK(curr, rpyr, from, to, s, cv::noArray(), win, from_offset ? 0 : opt_.pyramid_levels,
@@ -330,7 +330,7 @@ void StereoTracker::match_stereo(const Pyramid& curr, const cv::Mat& right_in, s
   for (std::size_t k = 0; k < matched.size(); ++k)
     stereo_ok[matched[k]] = back_st[k] && distance(back[k], lpx[matched[k]]) <= opt_.max_back_error;
   for (std::size_t i = 0; i < n; ++i) {
-    Track& t = (*tracks)[i];
+    Track& t = tracks[i];
     t.stereo_offset.x = std::numeric_limits<float>::quiet_NaN();
     if (!searched[i]) continue;  // waiting (see above)
     if (!stereo_ok[i]) {
@@ -338,20 +338,20 @@ void StereoTracker::match_stereo(const Pyramid& curr, const cv::Mat& right_in, s
       continue;
     }
     t.stereo_offset = rpx[i] - lpx[i];
-    TrackedFeature& f = out->features[i];
+    TrackedFeature& f = out.features[i];
     f.has_right = true;
     f.px_right = to_eigen(rpx[i]);
     f.bearing_right = cam1_->lift(f.px_right);
     f.xy_right = f.bearing_right.head<2>() / f.bearing_right.z();
-    ++out->stats.stereo;
+    ++out.stats.stereo;
   }
 }
 
 namespace {
 // Copies the simulator's label under each feature's rounded left pixel (for scoring only).
-void label_features(const cv::Mat& labels, std::vector<TrackedFeature>* features) {
+void label_features(const cv::Mat& labels, std::vector<TrackedFeature>& features) {
   if (labels.type() != CV_8UC1) throw std::invalid_argument("StereoTracker: labels must be CV_8U (one channel)");
-  for (TrackedFeature& f : *features) {
+  for (TrackedFeature& f : features) {
     const int c = static_cast<int>(std::lround(f.px.x())), r = static_cast<int>(std::lround(f.px.y()));
     if (r < 0 || c < 0 || r >= labels.rows || c >= labels.cols) continue;
     f.sim_label = static_cast<int8_t>(labels.at<uint8_t>(r, c));
@@ -370,15 +370,15 @@ TrackedFrame StereoTracker::process(const StereoFrame& frame, std::optional<Eige
   out.seq = frame.seq;
   out.image = frame.left;  // shallow: the estimator keeps it while the frame is in its window (keyframes)
 
-  pyramid(left, &curr_pyr_);
+  pyramid(left, curr_pyr_);
   const Pyramid& curr = curr_pyr_;
   std::vector<cv::Point2f> prev_px;
-  std::vector<Track> tracks = track_temporal(curr, R_prev_curr_cam0, &prev_px, &out.stats);
-  if (opt_.patch_refine) refine_with_patches(left, &tracks, &prev_px, &out.stats);
+  std::vector<Track> tracks = track_temporal(curr, R_prev_curr_cam0, prev_px, out.stats);
+  if (opt_.patch_refine) refine_with_patches(left, tracks, prev_px, out.stats);
   // Bearings once the pixels are final (the lift iterates for distorted lenses).
   for (auto& t : tracks) t.bearing = cam0_->lift(to_eigen(t.px));
-  if (opt_.f_ransac) reject_with_f(&tracks, &prev_px, &out.stats);
-  enforce_spacing_and_detect(left, &tracks, &prev_px, &out.stats);
+  if (opt_.f_ransac) reject_with_f(tracks, prev_px, out.stats);
+  enforce_spacing_and_detect(left, tracks, prev_px, out.stats);
 
   const double dt = prev_pyr_.empty() ? 0.0 : static_cast<double>(frame.t_ns - prev_t_ns_) * 1e-9;
   out.features.resize(tracks.size());
@@ -392,9 +392,9 @@ TrackedFrame StereoTracker::process(const StereoFrame& frame, std::optional<Eige
     f.bearing = t.bearing;
     f.xy = t.bearing.head<2>() / t.bearing.z();
   }
-  if (!frame.labels.empty()) label_features(frame.labels, &out.features);
+  if (!frame.labels.empty()) label_features(frame.labels, out.features);
 
-  if (stereo && !tracks.empty()) match_stereo(curr, prepare(frame.right, "right", frame.t_ns), &tracks, &out);
+  if (stereo && !tracks.empty()) match_stereo(curr, prepare(frame.right, "right", frame.t_ns), tracks, out);
   else
     for (Track& t : tracks) t.stereo_offset.x = std::numeric_limits<float>::quiet_NaN();
 
@@ -404,4 +404,4 @@ TrackedFrame StereoTracker::process(const StereoFrame& frame, std::optional<Eige
   return out;
 }
 
-}  // namespace dynavins
+}  // namespace dynavins::tracker

@@ -19,7 +19,7 @@
 #include "stages/tracker/patch_template.hpp"
 #include "stages/tracker/tracker_options.hpp"
 
-namespace dynavins {
+namespace dynavins::tracker {
 
 class StereoTracker {
  public:
@@ -59,15 +59,15 @@ class StereoTracker {
 
   /// Checks type and size against the calibration (errors name the frame time and which image).
   cv::Mat prepare(const cv::Mat& img, const char* which, int64_t t_ns) const;
-  void pyramid(const cv::Mat& img, Pyramid* pyr) const;
+  void pyramid(const cv::Mat& img, Pyramid& pyr) const;
   std::vector<Track> track_temporal(const Pyramid& curr, const std::optional<Eigen::Matrix3d>& R_prev_curr,
-                                    std::vector<cv::Point2f>* prev_px, TrackerStats* stats) const;
-  void refine_with_patches(const cv::Mat& img, std::vector<Track>* tracks, std::vector<cv::Point2f>* prev_px,
-                           TrackerStats* stats) const;
-  void reject_with_f(std::vector<Track>* tracks, std::vector<cv::Point2f>* prev_px, TrackerStats* stats) const;
-  void match_stereo(const Pyramid& left, const cv::Mat& right, std::vector<Track>* tracks, TrackedFrame* out);
-  void enforce_spacing_and_detect(const cv::Mat& img, std::vector<Track>* tracks, std::vector<cv::Point2f>* prev_px,
-                                  TrackerStats* stats);
+                                    std::vector<cv::Point2f>& prev_px, TrackerStats& stats) const;
+  void refine_with_patches(const cv::Mat& img, std::vector<Track>& tracks, std::vector<cv::Point2f>& prev_px,
+                           TrackerStats& stats) const;
+  void reject_with_f(std::vector<Track>& tracks, std::vector<cv::Point2f>& prev_px, TrackerStats& stats) const;
+  void match_stereo(const Pyramid& left, const cv::Mat& right, std::vector<Track>& tracks, TrackedFrame& out);
+  void enforce_spacing_and_detect(const cv::Mat& img, std::vector<Track>& tracks, std::vector<cv::Point2f>& prev_px,
+                                  TrackerStats& stats);
   bool in_border(const cv::Point2f& p, const cv::Size& size) const;
 
   TrackerOptions opt_;
@@ -83,4 +83,4 @@ class StereoTracker {
   int64_t next_id_ = 0;
 };
 
-}  // namespace dynavins
+}  // namespace dynavins::tracker

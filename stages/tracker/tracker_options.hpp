@@ -3,7 +3,7 @@
 
 #include "stages/common/estimator_options.hpp"
 
-namespace dynavins {
+namespace dynavins::tracker {
 
 struct TrackerOptions {
   int max_cnt = 150;      ///< features kept per frame
@@ -48,4 +48,4 @@ struct TrackerOptions {
   }
 };
 
-}  // namespace dynavins
+}  // namespace dynavins::tracker

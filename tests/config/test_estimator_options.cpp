@@ -272,7 +272,7 @@ std::string exact(T x) {
 }
 
 // A value of the key other than its default, inside its range, as yaml / --set text.
-std::string otherValue(const OptionSpec& s) {
+std::string other_value(const OptionSpec& s) {
   return std::visit(
       [&](auto m) -> std::string {
         const auto d = EstimatorOptions{}.*m;
@@ -289,7 +289,7 @@ std::string otherValue(const OptionSpec& s) {
 }
 
 // Values of the key outside its range (flags: not a flag at all).
-std::vector<std::string> badValues(const OptionSpec& s) {
+std::vector<std::string> bad_values(const OptionSpec& s) {
   return std::visit(
       [&](auto m) -> std::vector<std::string> {
         using T = std::remove_reference_t<decltype(EstimatorOptions{}.*m)>;
@@ -304,7 +304,7 @@ std::vector<std::string> badValues(const OptionSpec& s) {
 }
 
 // `text` without its top-level lines for `keys`, then "key: value" for each.
-std::string withKeys(const std::string& text, const std::vector<std::pair<std::string, std::string>>& kv) {
+std::string with_keys(const std::string& text, const std::vector<std::pair<std::string, std::string>>& kv) {
   std::istringstream in(text);
   std::ostringstream out;
   for (std::string line; std::getline(in, line);) {
@@ -317,7 +317,7 @@ std::string withKeys(const std::string& text, const std::vector<std::pair<std::s
 }
 
 // The "(file)" / "(--set)" / "(default)" mark print() gives `key`.
-std::string sourceOf(const std::string& printed, const std::string& key) {
+std::string source_of(const std::string& printed, const std::string& key) {
   const std::regex line("\n  " + key + " += [^\n]*  \\(([-a-z]+)\\)");
   std::smatch m;
   return std::regex_search(printed, m, line) ? m[1].str() : "(not printed)";
@@ -326,7 +326,7 @@ std::string sourceOf(const std::string& printed, const std::string& key) {
 using test::LogCapture;
 
 template <typename T>
-bool sameValue(T field, const std::string& written) {
+bool same_value(T field, const std::string& written) {
   if constexpr (std::is_same_v<T, bool>) return field == (written == "true");
   if constexpr (std::is_same_v<T, int>) return field == std::stoi(written);
   return field == std::stod(written);
@@ -348,20 +348,20 @@ TEST_CASE("The new keys default to the values the estimator used before they wer
 TEST_CASE("Every key of the table and the rig, set in the yaml, takes effect and is marked (file)", "[options][table]") {
   ScratchConfig s(kEuroc);
   std::vector<std::pair<std::string, std::string>> kv;
-  for (const OptionSpec& spec : optionSpecs()) kv.emplace_back(spec.key, otherValue(spec));
+  for (const OptionSpec& spec : option_specs()) kv.emplace_back(spec.key, other_value(spec));
   // The rig keys the EuRoC file does not already carry with other values than the defaults.
   kv.emplace_back("cam0_calib", "\"cam0_pinhole.yaml\"");
   kv.emplace_back("cam1_calib", "\"cam1_pinhole.yaml\"");
   const std::string path = (s.dir / "every_key.yaml").string();
-  std::ofstream(path) << withKeys(slurp((s.dir / "euroc_stereo_imu_config.yaml").string()), kv);
+  std::ofstream(path) << with_keys(slurp((s.dir / "euroc_stereo_imu_config.yaml").string()), kv);
 
   const auto o = EstimatorOptions::load(path);
   const std::string printed = o.print();
-  for (const OptionSpec& spec : optionSpecs()) {
-    const std::string written = otherValue(spec);
+  for (const OptionSpec& spec : option_specs()) {
+    const std::string written = other_value(spec);
     INFO(spec.key << " written " << written << ", loaded " << o.value(spec.key));
-    CHECK(std::visit([&](auto m) { return sameValue(o.*m, written); }, spec.field));
-    CHECK(sourceOf(printed, spec.key) == "file");
+    CHECK(std::visit([&](auto m) { return same_value(o.*m, written); }, spec.field));
+    CHECK(source_of(printed, spec.key) == "file");
   }
   CHECK(o.lambda_w == o.regularization_gamma * o.regularization_gamma);
   CHECK(o.use_imu);
@@ -370,27 +370,27 @@ TEST_CASE("Every key of the table and the rig, set in the yaml, takes effect and
   CHECK(o.cameras[0]->name() == "PINHOLE");
   CHECK(o.cameras[1]->name() == "PINHOLE");
   CHECK(o.body_T_cam[1](0, 3) == Approx(-0.0198435579556));
-  for (const auto& [key, help] : rigKeys()) {
+  for (const auto& [key, help] : rig_keys()) {
     INFO(key);
-    CHECK(sourceOf(printed, key) == "file");
+    CHECK(source_of(printed, key) == "file");
   }
   CHECK(o.unknown_keys.empty());
 }
 
 TEST_CASE("Every key of the table, set with --set, takes effect and is marked (--set)", "[options][table]") {
   std::vector<std::pair<std::string, std::string>> kv;
-  for (const OptionSpec& spec : optionSpecs()) kv.emplace_back(spec.key, otherValue(spec));
+  for (const OptionSpec& spec : option_specs()) kv.emplace_back(spec.key, other_value(spec));
   const auto o = EstimatorOptions::load(kEuroc + "euroc_stereo_imu_config.yaml", kv);
   const std::string printed = o.print();
   for (const auto& [key, written] : kv) {
     INFO(key << " set " << written << ", got " << o.value(key));
-    const OptionSpec& spec = *std::find_if(optionSpecs().begin(), optionSpecs().end(),
+    const OptionSpec& spec = *std::find_if(option_specs().begin(), option_specs().end(),
                                           [&](const OptionSpec& x) { return key == x.key; });
-    CHECK(std::visit([&](auto m) { return sameValue(o.*m, written); }, spec.field));
-    CHECK(sourceOf(printed, key) == "--set");
+    CHECK(std::visit([&](auto m) { return same_value(o.*m, written); }, spec.field));
+    CHECK(source_of(printed, key) == "--set");
   }
   CHECK(o.lambda_w == o.regularization_gamma * o.regularization_gamma);
-  CHECK(sourceOf(printed, "imu") == "file");
+  CHECK(source_of(printed, "imu") == "file");
 }
 
 TEST_CASE("Each key's out-of-range value is rejected on load and on --set, naming the key", "[options][table]") {
@@ -399,10 +399,10 @@ TEST_CASE("Each key's out-of-range value is rejected on load and on --set, namin
   const std::string path = (s.dir / "bad_value.yaml").string();
   EstimatorOptions o = EstimatorOptions::load(kEuroc + "euroc_stereo_imu_config.yaml");
   const std::string before = o.print();
-  for (const OptionSpec& spec : optionSpecs()) {
-    for (const std::string& v : badValues(spec)) {
+  for (const OptionSpec& spec : option_specs()) {
+    for (const std::string& v : bad_values(spec)) {
       INFO(spec.key << ": " << v);
-      std::ofstream(path) << withKeys(base, {{spec.key, v}});
+      std::ofstream(path) << with_keys(base, {{spec.key, v}});
       CHECK_THROWS_WITH(EstimatorOptions::load(path),
                         Catch::Contains(path) && Catch::Contains(std::string("'") + spec.key + "'"));
       CHECK_THROWS_WITH(o.apply(spec.key, v), Catch::Contains("--set") && Catch::Contains(std::string("'") + spec.key + "'"));
@@ -424,7 +424,7 @@ TEST_CASE("window_size 1 and 100000000 are rejected", "[options][table]") {
   const std::string ok = s.edit("euroc_stereo_imu_config.yaml", "keyframe_parallax: 10.0",
                                 "keyframe_parallax: 10.0\nwindow_size: 12");
   CHECK(EstimatorOptions::load(ok).window_size == 12);  // read from the yaml, not only from --set
-  CHECK(sourceOf(EstimatorOptions::load(ok).print(), "window_size") == "file");
+  CHECK(source_of(EstimatorOptions::load(ok).print(), "window_size") == "file");
 }
 
 TEST_CASE("NaN and Inf in the config are rejected naming the key and the file", "[options][table]") {
@@ -504,6 +504,6 @@ TEST_CASE("README.md's key table is the one the code generates", "[options][tabl
   REQUIRE(e != std::string::npos);
   const std::string table = readme.substr(b + begin.size(), e - b - begin.size());
   // On a failure, paste `build/bin/dynavins info --options-markdown` between the markers.
-  CHECK(table == optionsMarkdownTable());
-  for (const OptionSpec& spec : optionSpecs()) CHECK_THAT(table, Catch::Contains(std::string("| `") + spec.key + "` |"));
+  CHECK(table == options_markdown_table());
+  for (const OptionSpec& spec : option_specs()) CHECK_THAT(table, Catch::Contains(std::string("| `") + spec.key + "` |"));
 }

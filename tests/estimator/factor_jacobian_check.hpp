@@ -52,7 +52,7 @@ inline Evaluation evaluate(const ceres::CostFunction& f, const BlockValues& para
 
 /// Central differences of `residual` at `params` along the tangent space of block `b`: a pose block is
 /// perturbed through PoseManifold::Plus (6 columns), any other additively (one column per entry).
-inline RowMajorMatrix numericTangentJacobian(const ResidualFunction& residual, const BlockValues& params, size_t b,
+inline RowMajorMatrix numeric_tangent_jacobian(const ResidualFunction& residual, const BlockValues& params, size_t b,
                                              Block kind, double step = 1e-6) {
   const bool pose = kind == Block::Pose;
   const int dim = pose ? 6 : static_cast<int>(params[b].size());
@@ -81,7 +81,7 @@ inline RowMajorMatrix numericTangentJacobian(const ResidualFunction& residual, c
 /// on the left by `row_transform` when it is not empty (e.g. the inverse of a whitening matrix, so that rows of
 /// very different scale are compared at their natural size). Also requires column 7 of a pose block to be
 /// zero, and a null Jacobian pointer to leave residual and the other blocks unchanged.
-inline void requireJacobiansMatchNumeric(const ceres::CostFunction& f,
+inline void require_jacobians_match_numeric(const ceres::CostFunction& f,
                                          const std::vector<std::vector<double>>& params,
                                          const std::vector<Block>& kinds,
                                          const Eigen::MatrixXd& row_transform = {}, double step = 1e-6,
@@ -94,7 +94,7 @@ inline void requireJacobiansMatchNumeric(const ceres::CostFunction& f,
   for (size_t b = 0; b < params.size(); ++b) {
     const bool pose = kinds[b] == Block::Pose;
     const int dim = pose ? 6 : static_cast<int>(params[b].size());
-    RowMajorMatrix numeric = numericTangentJacobian(residual, params, b, kinds[b], step);
+    RowMajorMatrix numeric = numeric_tangent_jacobian(residual, params, b, kinds[b], step);
     RowMajorMatrix a = analytic.jacobians[b].leftCols(dim);
     if (row_transform.size() > 0) {
       a = row_transform * a;
@@ -119,7 +119,7 @@ inline void requireJacobiansMatchNumeric(const ceres::CostFunction& f,
 }
 
 /// A pose block [p, q xyzw] from a position and rotation.
-inline std::vector<double> poseBlock(const Eigen::Vector3d& p, const Eigen::Matrix3d& R) {
+inline std::vector<double> pose_block(const Eigen::Vector3d& p, const Eigen::Matrix3d& R) {
   const Eigen::Quaterniond q(R);
   return {p.x(), p.y(), p.z(), q.x(), q.y(), q.z(), q.w()};
 }

@@ -1,4 +1,4 @@
-// estimateGyroBias: recovers a known gyroscope bias from true rotations and preintegrations built
+// estimate_gyro_bias: recovers a known gyroscope bias from true rotations and preintegrations built
 // with zero bias (VINS-Mono §V-B-1).
 #include <catch2/catch.hpp>
 
@@ -11,7 +11,7 @@ using namespace dynavins::estimator;
 using namespace dynavins::estimator::test;
 
 namespace {
-std::vector<Eigen::Matrix3d> trueRotations(const Scenario& s) {
+std::vector<Eigen::Matrix3d> true_rotations(const Scenario& s) {
   std::vector<Eigen::Matrix3d> R;
   for (const auto& st : s.truth) R.push_back(st.R_wb);
   return R;
@@ -21,8 +21,8 @@ std::vector<Eigen::Matrix3d> trueRotations(const Scenario& s) {
 TEST_CASE("gyro bias from true rotations with a noise-free IMU", "[estimator][initialization]") {
   ScenarioOptions o;
   o.gyro_bias = Eigen::Vector3d(0.02, -0.015, 0.03);
-  const Scenario s = makeScenario(o);
-  const Eigen::Vector3d bg = estimateGyroBias(trueRotations(s), s.preintPointers());
+  const Scenario s = make_scenario(o);
+  const Eigen::Vector3d bg = estimate_gyro_bias(true_rotations(s), s.preint_pointers());
   INFO("estimated " << bg.transpose() << " true " << o.gyro_bias.transpose());
   CHECK((bg - o.gyro_bias).norm() < 1e-3);
 
@@ -30,7 +30,7 @@ TEST_CASE("gyro bias from true rotations with a noise-free IMU", "[estimator][in
   for (int k = 0; k + 1 < s.frames(); ++k) {
     s.preints[k]->repropagate(Eigen::Vector3d::Zero(), bg);
     const Eigen::Matrix3d R_rel = s.truth[k].R_wb.transpose() * s.truth[k + 1].R_wb;
-    CHECK(so3::log(s.preints[k]->deltaQ().toRotationMatrix().transpose() * R_rel).norm() < 1e-4);
+    CHECK(so3::log(s.preints[k]->delta_q().toRotationMatrix().transpose() * R_rel).norm() < 1e-4);
   }
 }
 
@@ -38,16 +38,16 @@ TEST_CASE("gyro bias from true rotations with a noisy IMU", "[estimator][initial
   ScenarioOptions o;
   o.imu_noise = true;
   o.gyro_bias = Eigen::Vector3d(-0.01, 0.025, 0.015);
-  const Scenario s = makeScenario(o);
-  const Eigen::Vector3d bg = estimateGyroBias(trueRotations(s), s.preintPointers());
+  const Scenario s = make_scenario(o);
+  const Eigen::Vector3d bg = estimate_gyro_bias(true_rotations(s), s.preint_pointers());
   INFO("estimated " << bg.transpose() << " true " << o.gyro_bias.transpose());
   // EuRoC-grade gyro white noise over 1 s contributes ~2e-4 rad/s.
   CHECK((bg - o.gyro_bias).norm() < 1e-3);
 }
 
 TEST_CASE("gyro bias rejects mismatched inputs", "[estimator][initialization]") {
-  const Scenario s = makeScenario();
-  std::vector<Eigen::Matrix3d> R = trueRotations(s);
+  const Scenario s = make_scenario();
+  std::vector<Eigen::Matrix3d> R = true_rotations(s);
   R.pop_back();
-  CHECK_THROWS_AS(estimateGyroBias(R, s.preintPointers()), std::invalid_argument);
+  CHECK_THROWS_AS(estimate_gyro_bias(R, s.preint_pointers()), std::invalid_argument);
 }

@@ -1,4 +1,4 @@
-// initializeMono: poses, velocities, bias and depths vs the truth in the gravity-aligned, zero-yaw,
+// initialize_mono: poses, velocities, bias and depths vs the truth in the gravity-aligned, zero-yaw,
 // first-body-origin world; pure rotation and a missing preintegration fail with a reason.
 #include <catch2/catch.hpp>
 
@@ -22,10 +22,10 @@ struct InitErrors {
 InitErrors compare(const Scenario& s, const MonoInitResult& r, const Eigen::Vector3d& bg_true) {
   // The truth in the initializer's convention: yaw of body 0 removed, origin at body 0.
   const Eigen::Matrix3d R_align =
-      Eigen::AngleAxisd(-yawOf(s.truth[0].R_wb), Eigen::Vector3d::UnitZ()).toRotationMatrix();
+      Eigen::AngleAxisd(-yaw_of(s.truth[0].R_wb), Eigen::Vector3d::UnitZ()).toRotationMatrix();
   InitErrors e;
   for (int k = 0; k < s.frames(); ++k) {
-    e.rot_deg = std::max(e.rot_deg, angleDeg((R_align * s.truth[k].R_wb).transpose() * r.R_wb[k]));
+    e.rot_deg = std::max(e.rot_deg, angle_deg((R_align * s.truth[k].R_wb).transpose() * r.R_wb[k]));
     e.pos_m = std::max(e.pos_m, (R_align * (s.truth[k].p_w - s.truth[0].p_w) - r.p_wb[k]).norm());
     e.vel_mps = std::max(e.vel_mps, (R_align * s.truth[k].v_w - r.v_wb[k]).norm());
   }
@@ -41,8 +41,8 @@ InitErrors compare(const Scenario& s, const MonoInitResult& r, const Eigen::Vect
 
 TEST_CASE("mono initializer on noise-free data matches the truth", "[estimator][initialization]") {
   ScenarioOptions o;
-  const Scenario s = makeScenario(o);
-  const MonoInitResult r = initializeMono(s.window(), s.R_bc, s.p_bc);
+  const Scenario s = make_scenario(o);
+  const MonoInitResult r = initialize_mono(s.window(), s.R_bc, s.p_bc);
   INFO(r.reason);
   REQUIRE(r.success);
   REQUIRE(static_cast<int>(r.p_wb.size()) == s.frames());
@@ -50,7 +50,7 @@ TEST_CASE("mono initializer on noise-free data matches the truth", "[estimator][
   INFO("rot " << e.rot_deg << " deg, pos " << e.pos_m << " m, vel " << e.vel_mps << " m/s, depth " << e.depth_rel
               << ", bg " << e.bg << ", scale " << r.scale << ", l " << r.sfm_reference_frame);
   CHECK(r.p_wb[0].norm() < 1e-12);
-  CHECK(std::abs(yawOf(r.R_wb[0])) < 1e-9);
+  CHECK(std::abs(yaw_of(r.R_wb[0])) < 1e-9);
   CHECK(e.bg < 1e-3);
   CHECK(e.rot_deg < 0.1);
   CHECK(e.pos_m < 0.02);
@@ -58,7 +58,7 @@ TEST_CASE("mono initializer on noise-free data matches the truth", "[estimator][
   CHECK(r.depths.size() > 150);
   CHECK(e.depth_rel < 0.01);
   // The preintegrations now carry the estimated bias.
-  for (const auto& p : s.preints) CHECK((p->linearizedBg() - r.bg).norm() < 1e-12);
+  for (const auto& p : s.preints) CHECK((p->linearized_bg() - r.bg).norm() < 1e-12);
 }
 
 TEST_CASE("mono initializer with 0.5 px and EuRoC-grade IMU noise", "[estimator][initialization]") {
@@ -68,8 +68,8 @@ TEST_CASE("mono initializer with 0.5 px and EuRoC-grade IMU noise", "[estimator]
   o.pixel_noise_px = 0.5;
   o.imu_noise = true;
   o.seed = seed;
-  const Scenario s = makeScenario(o);
-  const MonoInitResult r = initializeMono(s.window(), s.R_bc, s.p_bc);
+  const Scenario s = make_scenario(o);
+  const MonoInitResult r = initialize_mono(s.window(), s.R_bc, s.p_bc);
   INFO("seed " << seed << ": " << r.reason);
   REQUIRE(r.success);
   const InitErrors e = compare(s, r, o.gyro_bias);
@@ -88,8 +88,8 @@ TEST_CASE("mono initializer with 0.5 px and EuRoC-grade IMU noise", "[estimator]
 TEST_CASE("mono initializer fails cleanly on a pure rotation", "[estimator][initialization]") {
   ScenarioOptions o;
   o.pure_rotation = true;
-  const Scenario s = makeScenario(o);
-  const MonoInitResult r = initializeMono(s.window(), s.R_bc, s.p_bc);
+  const Scenario s = make_scenario(o);
+  const MonoInitResult r = initialize_mono(s.window(), s.R_bc, s.p_bc);
   INFO(r.reason);
   CHECK_FALSE(r.success);
   CHECK_FALSE(r.reason.empty());
@@ -99,8 +99,8 @@ TEST_CASE("mono initializer keeps 64-bit feature ids apart", "[estimator][initia
   // The tracker numbers features with int64_t; ids that agree in their low 32 bits are distinct tracks.
   ScenarioOptions o;
   o.wide_ids = true;
-  const Scenario s = makeScenario(o);
-  const MonoInitResult r = initializeMono(s.window(), s.R_bc, s.p_bc);
+  const Scenario s = make_scenario(o);
+  const MonoInitResult r = initialize_mono(s.window(), s.R_bc, s.p_bc);
   INFO(r.reason);
   REQUIRE(r.success);
   CHECK(r.depths.size() > 150);
@@ -112,15 +112,15 @@ TEST_CASE("mono initializer keeps 64-bit feature ids apart", "[estimator][initia
 
 namespace {
 // The initializer on a window whose motion leaves the scale unobservable (0.5 px, EuRoC-grade IMU).
-MonoInitResult initializeUnobservable(bool constant_acceleration, uint64_t seed) {
+MonoInitResult initialize_unobservable(bool constant_acceleration, uint64_t seed) {
   ScenarioOptions o;
   o.constant_velocity = !constant_acceleration;
   o.constant_acceleration = constant_acceleration;
   o.pixel_noise_px = 0.5;
   o.imu_noise = true;
   o.seed = seed;
-  const Scenario s = makeScenario(o);
-  return initializeMono(s.window(), s.R_bc, s.p_bc);
+  const Scenario s = make_scenario(o);
+  return initialize_mono(s.window(), s.R_bc, s.p_bc);
 }
 }  // namespace
 
@@ -129,7 +129,7 @@ TEST_CASE("mono initializer refuses a scale that constant velocity leaves unobse
   // Without acceleration the IMU cannot tell the scale (any s with v = s * visual velocity fits); the
   // noise then picks an arbitrary scale, which must be rejected rather than start the estimator.
   const uint64_t seed = GENERATE(7, 8, 9);
-  const MonoInitResult r = initializeUnobservable(false, seed);
+  const MonoInitResult r = initialize_unobservable(false, seed);
   INFO("seed " << seed << ": " << r.reason << " scale " << r.scale);
   // Without the scale-uncertainty test seeds 7 and 8 "succeed" with arbitrary scales;
   // seed 9 already fails the free-gravity test.
@@ -142,17 +142,17 @@ TEST_CASE("mono initializer refuses a scale that constant acceleration leaves un
   // A constant acceleration is indistinguishable from a tilted, stronger gravity: the free-gravity solve
   // fits any scale (the lever arm aside). The window's excitation tells, whatever the scale's fit says.
   const uint64_t seed = GENERATE(7, 8, 9);
-  const MonoInitResult r = initializeUnobservable(true, seed);
+  const MonoInitResult r = initialize_unobservable(true, seed);
   INFO("seed " << seed << ": " << r.reason << " scale " << r.scale);
   CHECK_FALSE(r.success);
   CHECK_THAT(r.reason, Catch::Contains("excitation"));
 }
 
 TEST_CASE("mono initializer reports a missing preintegration", "[estimator][initialization]") {
-  const Scenario s = makeScenario();
+  const Scenario s = make_scenario();
   std::vector<InitWindowFrame> w = s.window();
   w[4].preint = nullptr;
-  const MonoInitResult r = initializeMono(w, s.R_bc, s.p_bc);
+  const MonoInitResult r = initialize_mono(w, s.R_bc, s.p_bc);
   CHECK_FALSE(r.success);
   CHECK(r.reason.find("preintegration") != std::string::npos);
 }

@@ -1,4 +1,4 @@
-// solveMonoSfm: camera poses and points match the truth up to a similarity; pure rotation and too few
+// solve_mono_sfm: camera poses and points match the truth up to a similarity; pure rotation and too few
 // features fail with a reason; the helper geometry (triangulation, rotation-compensated parallax).
 #include <catch2/catch.hpp>
 
@@ -33,7 +33,7 @@ SfmErrors compare(const Scenario& s, const MonoSfmResult& r) {
   std::vector<Eigen::Vector3d> p_true;
   double num = 0.0, den = 0.0, longest = 0.0;
   for (int k = 0; k < s.frames(); ++k) {
-    e.max_rot_deg = std::max(e.max_rot_deg, angleDeg((R_wl.transpose() * s.R_wc(k)).transpose() * r.R_lc[k]));
+    e.max_rot_deg = std::max(e.max_rot_deg, angle_deg((R_wl.transpose() * s.R_wc(k)).transpose() * r.R_lc[k]));
     p_true.push_back(R_wl.transpose() * (s.p_wc(k) - p_wl));
     num += p_true[k].dot(r.p_lc[k]);
     den += r.p_lc[k].squaredNorm();
@@ -60,8 +60,8 @@ SfmErrors compare(const Scenario& s, const MonoSfmResult& r) {
 }  // namespace
 
 TEST_CASE("mono SfM matches the truth up to a similarity on noise-free data", "[estimator][initialization]") {
-  const Scenario s = makeScenario();
-  const MonoSfmResult r = solveMonoSfm(s.features);
+  const Scenario s = make_scenario();
+  const MonoSfmResult r = solve_mono_sfm(s.features);
   INFO(r.reason);
   REQUIRE(r.success);
   REQUIRE(static_cast<int>(r.R_lc.size()) == s.frames());
@@ -81,8 +81,8 @@ TEST_CASE("mono SfM with 0.5 px noise", "[estimator][initialization]") {
   ScenarioOptions o;
   o.pixel_noise_px = 0.5;
   o.seed = seed;
-  const Scenario s = makeScenario(o);
-  const MonoSfmResult r = solveMonoSfm(s.features);
+  const Scenario s = make_scenario(o);
+  const MonoSfmResult r = solve_mono_sfm(s.features);
   INFO("seed " << seed << ": " << r.reason);
   REQUIRE(r.success);
   const SfmErrors e = compare(s, r);
@@ -102,23 +102,23 @@ TEST_CASE("mono SfM fails on a pure rotation", "[estimator][initialization]") {
   ScenarioOptions o;
   o.pure_rotation = true;
   o.pixel_noise_px = 0.5;
-  const Scenario s = makeScenario(o);
-  const MonoSfmResult r = solveMonoSfm(s.features);
+  const Scenario s = make_scenario(o);
+  const MonoSfmResult r = solve_mono_sfm(s.features);
   INFO(r.reason);
   CHECK_FALSE(r.success);
   CHECK(r.reason.find("pure rotation") != std::string::npos);
 }
 
 TEST_CASE("mono SfM fails with too few common features", "[estimator][initialization]") {
-  Scenario s = makeScenario();
+  Scenario s = make_scenario();
   // Keep only 15 features in the newest frame.
   FrameFeatures& newest = s.features.back();
   while (newest.size() > 15) newest.erase(std::prev(newest.end()));
-  const MonoSfmResult r = solveMonoSfm(s.features);
+  const MonoSfmResult r = solve_mono_sfm(s.features);
   INFO(r.reason);
   CHECK_FALSE(r.success);
   CHECK(r.reason.find("common features") != std::string::npos);
-  CHECK_FALSE(solveMonoSfm({}).success);
+  CHECK_FALSE(solve_mono_sfm({}).success);
 }
 
 TEST_CASE("rotation-compensated parallax separates rotation from translation", "[estimator][initialization]") {
@@ -135,8 +135,8 @@ TEST_CASE("rotation-compensated parallax separates rotation from translation", "
     xb_rot.push_back(r.head<2>() / r.z());
     xb_move.push_back(m.head<2>() / m.z());
   }
-  CHECK(rotationCompensatedParallaxPx(xa, xb_rot, 460.0) < 1e-6);
-  CHECK(rotationCompensatedParallaxPx(xa, xb_move, 460.0) > 5.0);
+  CHECK(rotation_compensated_parallax_px(xa, xb_rot, 460.0) < 1e-6);
+  CHECK(rotation_compensated_parallax_px(xa, xb_move, 460.0) > 5.0);
 }
 
 TEST_CASE("two-view triangulation recovers a point and rejects one behind", "[estimator][initialization]") {
@@ -147,11 +147,11 @@ TEST_CASE("two-view triangulation recovers a point and rejects one behind", "[es
   const Eigen::Vector3d P(0.3, -0.2, 4.0);
   const Eigen::Vector3d pa = Ra * P + ta, pb = Rb * P + tb;
   Eigen::Vector3d X;
-  REQUIRE(triangulateTwoViews(Ra, ta, pa.head<2>() / pa.z(), Rb, tb, pb.head<2>() / pb.z(), X));
+  REQUIRE(triangulate_two_views(Ra, ta, pa.head<2>() / pa.z(), Rb, tb, pb.head<2>() / pb.z(), X));
   CHECK((X - P).norm() < 1e-9);
   const Eigen::Vector3d Q(0.3, -0.2, -4.0);  // behind camera a
   const Eigen::Vector3d qa = Ra * Q + ta, qb = Rb * Q + tb;
-  CHECK_FALSE(triangulateTwoViews(Ra, ta, qa.head<2>() / qa.z(), Rb, tb, qb.head<2>() / qb.z(), X));
+  CHECK_FALSE(triangulate_two_views(Ra, ta, qa.head<2>() / qa.z(), Rb, tb, qb.head<2>() / qb.z(), X));
 }
 
 TEST_CASE("mono SfM with a reference frame after the first one", "[estimator][initialization]") {
@@ -159,7 +159,7 @@ TEST_CASE("mono SfM with a reference frame after the first one", "[estimator][in
   // placed by PnP going backwards from l.
   ScenarioOptions o;
   o.pixel_noise_px = 0.5;
-  Scenario s = makeScenario(o);
+  Scenario s = make_scenario(o);
   const FrameFeatures& newest = s.features.back();
   for (int k : {0, 1}) {
     int kept = 0;
@@ -168,7 +168,7 @@ TEST_CASE("mono SfM with a reference frame after the first one", "[estimator][in
       else ++it;
     }
   }
-  const MonoSfmResult r = solveMonoSfm(s.features);
+  const MonoSfmResult r = solve_mono_sfm(s.features);
   INFO(r.reason);
   REQUIRE(r.success);
   CHECK(r.reference_frame == 2);
@@ -188,7 +188,7 @@ TEST_CASE("mono SfM tolerates a few gross outliers", "[estimator][initialization
   // 10 % of the tracks get one observation at a random image position (a tracker slip); the rest 0.5 px noise.
   ScenarioOptions o;
   o.pixel_noise_px = 0.5;
-  Scenario s = makeScenario(o);
+  Scenario s = make_scenario(o);
   std::mt19937 rng(21);
   std::uniform_real_distribution<double> u(0.0, 1.0), x(-0.8, 0.8);
   std::set<int> corrupted;
@@ -203,7 +203,7 @@ TEST_CASE("mono SfM tolerates a few gross outliers", "[estimator][initialization
     s.features[k][id] = Eigen::Vector2d(x(rng), 0.8 * x(rng));
     corrupted.insert(id);
   }
-  const MonoSfmResult r = solveMonoSfm(s.features);
+  const MonoSfmResult r = solve_mono_sfm(s.features);
   INFO(r.reason);
   REQUIRE(r.success);
   const SfmErrors e = compare(s, r);

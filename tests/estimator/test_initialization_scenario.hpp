@@ -45,13 +45,13 @@ struct Scenario {
   Eigen::Vector3d p_bc;
   std::map<FeatureId, Eigen::Vector3d> landmarks_w;
   std::vector<FrameFeatures> features;
-  std::vector<std::unique_ptr<ImuPreintegration>> preints;  ///< frame k -> k+1
+  std::vector<std::unique_ptr<imu::ImuPreintegration>> preints;  ///< frame k -> k+1
 
   int frames() const { return static_cast<int>(t.size()); }
   Eigen::Matrix3d R_wc(int k) const { return truth[k].R_wb * R_bc; }
   Eigen::Vector3d p_wc(int k) const { return truth[k].p_w + truth[k].R_wb * p_bc; }
-  std::vector<const ImuPreintegration*> preintPointers() const {
-    std::vector<const ImuPreintegration*> v;
+  std::vector<const imu::ImuPreintegration*> preint_pointers() const {
+    std::vector<const imu::ImuPreintegration*> v;
     for (const auto& p : preints) v.push_back(p.get());
     return v;
   }
@@ -67,7 +67,7 @@ struct Scenario {
   }
 };
 
-inline sim::SmoothTrajectory scenarioTrajectory(bool pure_rotation, bool constant_velocity = false,
+inline sim::SmoothTrajectory scenario_trajectory(bool pure_rotation, bool constant_velocity = false,
                                                 bool constant_acceleration = false) {
   std::vector<sim::Waypoint> w;
   for (int i = 0; i <= 12; ++i) {
@@ -85,12 +85,12 @@ inline sim::SmoothTrajectory scenarioTrajectory(bool pure_rotation, bool constan
     p.roll = 0.1 * std::cos(1.9 * t);
     w.push_back(p);
   }
-  return sim::trajectoryFromTimedWaypoints(w);
+  return sim::trajectory_from_timed_waypoints(w);
 }
 
-inline Scenario makeScenario(const ScenarioOptions& o = {}) {
+inline Scenario make_scenario(const ScenarioOptions& o = {}) {
   Scenario s;
-  s.traj = scenarioTrajectory(o.pure_rotation, o.constant_velocity, o.constant_acceleration);
+  s.traj = scenario_trajectory(o.pure_rotation, o.constant_velocity, o.constant_acceleration);
   // Camera looking along body x (body x forward, y left, z up; camera z forward, x right, y down).
   s.R_bc << 0, 0, 1, -1, 0, 0, 0, -1, 0;
   s.p_bc = Eigen::Vector3d(0.05, 0.02, -0.01);
@@ -122,18 +122,18 @@ inline Scenario makeScenario(const ScenarioOptions& o = {}) {
 
   sim::ImuSimulatorOptions io;
   io.rate_hz = 200.0;
-  io.noise = o.imu_noise ? sim::ImuNoiseModel{} : sim::ImuNoiseModel::noiseFree();
+  io.noise = o.imu_noise ? sim::ImuNoiseModel{} : sim::ImuNoiseModel::noise_free();
   io.noise.acc_bias_initial.setZero();
   io.noise.gyr_bias_initial = o.gyro_bias;
   io.seed = o.seed;
   const sim::ImuSimulation imu = sim::ImuSimulator(io).simulate(s.traj, t0_ns, t0_ns + (n - 1) * dt_ns);
   for (int k = 0; k + 1 < n; ++k) {
     const int64_t a = t0_ns + k * dt_ns, b = a + dt_ns;
-    std::unique_ptr<ImuPreintegration> pre;
+    std::unique_ptr<imu::ImuPreintegration> pre;
     for (const ImuSample& smp : imu.samples) {
       if (smp.t_ns < a || smp.t_ns > b) continue;
-      if (!pre) pre = std::make_unique<ImuPreintegration>(smp, Eigen::Vector3d::Zero(), Eigen::Vector3d::Zero(),
-                                                          ImuNoiseParams{});
+      if (!pre) pre = std::make_unique<imu::ImuPreintegration>(smp, Eigen::Vector3d::Zero(), Eigen::Vector3d::Zero(),
+                                                          imu::ImuNoiseParams{});
       else pre->integrate(smp);
     }
     s.preints.push_back(std::move(pre));
@@ -142,6 +142,6 @@ inline Scenario makeScenario(const ScenarioOptions& o = {}) {
 }
 
 /// Angle of a rotation matrix [deg].
-inline double angleDeg(const Eigen::Matrix3d& R) { return Eigen::AngleAxisd(R).angle() * 180.0 / M_PI; }
+inline double angle_deg(const Eigen::Matrix3d& R) { return Eigen::AngleAxisd(R).angle() * 180.0 / M_PI; }
 
 }  // namespace dynavins::estimator::test

@@ -26,7 +26,7 @@ namespace {
 
 using RowMajor = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>;
 
-Eigen::MatrixXd randomMatrix(int rows, int cols, std::mt19937& rng, double scale = 1.0) {
+Eigen::MatrixXd random_matrix(int rows, int cols, std::mt19937& rng, double scale = 1.0) {
   std::uniform_real_distribution<double> u(-scale, scale);
   Eigen::MatrixXd m(rows, cols);
   for (int i = 0; i < rows; ++i)
@@ -86,7 +86,7 @@ class NumericTangentCost final : public ceres::CostFunction {
       const test::Block kind = sizes[i] == 7 ? test::Block::Pose : test::Block::Euclidean;
       Eigen::Map<RowMajor> ji(jac[i], num_residuals(), sizes[i]);
       ji.setZero();
-      const RowMajor numeric = test::numericTangentJacobian(residual, values, i, kind);
+      const RowMajor numeric = test::numeric_tangent_jacobian(residual, values, i, kind);
       ji.leftCols(numeric.cols()) = numeric;
     }
     return true;
@@ -98,35 +98,35 @@ class NumericTangentCost final : public ceres::CostFunction {
 
 using Pose = std::array<double, 7>;
 
-Pose makePose(const Eigen::Vector3d& p, const Eigen::Matrix3d& R) {
+Pose make_pose(const Eigen::Vector3d& p, const Eigen::Matrix3d& R) {
   const Eigen::Quaterniond q(R);
   return {p.x(), p.y(), p.z(), q.x(), q.y(), q.z(), q.w()};
 }
-Eigen::Vector3d posOf(const double* x) { return Eigen::Map<const Eigen::Vector3d>(x); }
-Eigen::Matrix3d rotOf(const double* x) {
+Eigen::Vector3d pos_of(const double* x) { return Eigen::Map<const Eigen::Vector3d>(x); }
+Eigen::Matrix3d rot_of(const double* x) {
   return Eigen::Map<const Eigen::Quaterniond>(x + 3).normalized().toRotationMatrix();
 }
 
 /// Pose prior: W [p - p_m; Log(R_m^T R)].
-std::shared_ptr<ceres::CostFunction> posePrior(const Pose& measured, double weight) {
+std::shared_ptr<ceres::CostFunction> pose_prior(const Pose& measured, double weight) {
   return std::make_shared<NumericTangentCost>(
       [measured, weight](const std::vector<const double*>& x) {
         Eigen::VectorXd r(6);
-        r.head<3>() = posOf(x[0]) - posOf(measured.data());
-        r.tail<3>() = so3::log(rotOf(measured.data()).transpose() * rotOf(x[0]));
+        r.head<3>() = pos_of(x[0]) - pos_of(measured.data());
+        r.tail<3>() = so3::log(rot_of(measured.data()).transpose() * rot_of(x[0]));
         return Eigen::VectorXd(weight * r);
       },
       std::vector<int>{7}, 6);
 }
 
 /// Relative pose: W [R_i^T (p_j - p_i) - dp_m; Log(dR_m^T R_i^T R_j)].
-std::shared_ptr<ceres::CostFunction> relativePose(const Eigen::Vector3d& dp, const Eigen::Matrix3d& dR, double weight) {
+std::shared_ptr<ceres::CostFunction> relative_pose(const Eigen::Vector3d& dp, const Eigen::Matrix3d& dR, double weight) {
   return std::make_shared<NumericTangentCost>(
       [dp, dR, weight](const std::vector<const double*>& x) {
-        const Eigen::Matrix3d Ri = rotOf(x[0]);
+        const Eigen::Matrix3d Ri = rot_of(x[0]);
         Eigen::VectorXd r(6);
-        r.head<3>() = Ri.transpose() * (posOf(x[1]) - posOf(x[0])) - dp;
-        r.tail<3>() = so3::log(dR.transpose() * Ri.transpose() * rotOf(x[1]));
+        r.head<3>() = Ri.transpose() * (pos_of(x[1]) - pos_of(x[0])) - dp;
+        r.tail<3>() = so3::log(dR.transpose() * Ri.transpose() * rot_of(x[1]));
         return Eigen::VectorXd(weight * r);
       },
       std::vector<int>{7, 7}, 6);
@@ -140,7 +140,7 @@ struct TestFactor {
 };
 
 /// Marginalises `dropped` (block indices): every factor touching one goes into the info.
-std::shared_ptr<MarginalizationInfo> marginalizeBlocks(const std::vector<TestFactor>& factors,
+std::shared_ptr<MarginalizationInfo> marginalize_blocks(const std::vector<TestFactor>& factors,
                                                        const std::vector<double*>& blocks,
                                                        const std::set<int>& dropped) {
   auto info = std::make_shared<MarginalizationInfo>();
@@ -160,7 +160,7 @@ std::shared_ptr<MarginalizationInfo> marginalizeBlocks(const std::vector<TestFac
 }
 
 /// Adds the factors touching none of `dropped` to `problem`.
-void addRemainingFactors(ceres::Problem& problem, const std::vector<TestFactor>& factors,
+void add_remaining_factors(ceres::Problem& problem, const std::vector<TestFactor>& factors,
                          const std::vector<double*>& blocks, const std::set<int>& dropped) {
   for (const TestFactor& f : factors) {
     bool touches = false;
@@ -174,7 +174,7 @@ void addRemainingFactors(ceres::Problem& problem, const std::vector<TestFactor>&
   }
 }
 
-ceres::Problem::Options nonOwningOptions() {
+ceres::Problem::Options non_owning_options() {
   ceres::Problem::Options o;
   o.cost_function_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
   o.loss_function_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
@@ -182,7 +182,7 @@ ceres::Problem::Options nonOwningOptions() {
   return o;
 }
 
-ceres::Solver::Options tightSolverOptions() {
+ceres::Solver::Options tight_solver_options() {
   ceres::Solver::Options o;
   o.linear_solver_type = ceres::DENSE_QR;
   o.max_num_iterations = 100;
@@ -194,7 +194,7 @@ ceres::Solver::Options tightSolverOptions() {
 }
 
 /// Dense Jacobian of `problem` over `blocks` (tangent columns) at the current values.
-Eigen::MatrixXd denseJacobian(ceres::Problem& problem, const std::vector<double*>& blocks) {
+Eigen::MatrixXd dense_jacobian(ceres::Problem& problem, const std::vector<double*>& blocks) {
   ceres::Problem::EvaluateOptions eo;
   eo.parameter_blocks = blocks;
   ceres::CRSMatrix crs;
@@ -211,11 +211,11 @@ struct DenseSystem {
   Eigen::MatrixXd H;
   Eigen::VectorXd b;
 };
-DenseSystem denseSystem(const std::vector<TestFactor>& factors, const std::vector<double*>& blocks,
+DenseSystem dense_system(const std::vector<TestFactor>& factors, const std::vector<double*>& blocks,
                         const std::vector<double*>& order) {
-  ceres::Problem problem(nonOwningOptions());
-  addRemainingFactors(problem, factors, blocks, {});
-  const Eigen::MatrixXd J = denseJacobian(problem, order);
+  ceres::Problem problem(non_owning_options());
+  add_remaining_factors(problem, factors, blocks, {});
+  const Eigen::MatrixXd J = dense_jacobian(problem, order);
   std::vector<double> gradient;
   ceres::Problem::EvaluateOptions eo;
   eo.parameter_blocks = order;
@@ -224,20 +224,20 @@ DenseSystem denseSystem(const std::vector<TestFactor>& factors, const std::vecto
 }
 
 /// Linear chain x0..x4 (size 3): prior on x0 and x4, odometry x_i -> x_{i+1}, loops x0-x2 and x1-x3.
-std::vector<TestFactor> linearChain(std::mt19937& rng) {
-  auto sqrtInfo = [&rng] { return Eigen::MatrixXd(2.0 * Eigen::MatrixXd::Identity(3, 3) + randomMatrix(3, 3, rng, 0.5)); };
+std::vector<TestFactor> linear_chain(std::mt19937& rng) {
+  auto sqrtInfo = [&rng] { return Eigen::MatrixXd(2.0 * Eigen::MatrixXd::Identity(3, 3) + random_matrix(3, 3, rng, 0.5)); };
   auto link = [&](int i, int j) {
     const Eigen::MatrixXd a = sqrtInfo();
     return TestFactor{std::make_shared<LinearFactor>(std::vector<Eigen::MatrixXd>{-a, a},
-                                                     Eigen::VectorXd(randomMatrix(3, 1, rng))),
+                                                     Eigen::VectorXd(random_matrix(3, 1, rng))),
                       {i, j}, nullptr};
   };
   std::vector<TestFactor> f;
-  f.push_back({std::make_shared<LinearFactor>(std::vector<Eigen::MatrixXd>{sqrtInfo()}, Eigen::VectorXd(randomMatrix(3, 1, rng))), {0}, nullptr});
+  f.push_back({std::make_shared<LinearFactor>(std::vector<Eigen::MatrixXd>{sqrtInfo()}, Eigen::VectorXd(random_matrix(3, 1, rng))), {0}, nullptr});
   for (int i = 0; i < 4; ++i) f.push_back(link(i, i + 1));
   f.push_back(link(0, 2));
   f.push_back(link(1, 3));
-  f.push_back({std::make_shared<LinearFactor>(std::vector<Eigen::MatrixXd>{sqrtInfo()}, Eigen::VectorXd(randomMatrix(3, 1, rng))), {4}, nullptr});
+  f.push_back({std::make_shared<LinearFactor>(std::vector<Eigen::MatrixXd>{sqrtInfo()}, Eigen::VectorXd(random_matrix(3, 1, rng))), {4}, nullptr});
   return f;
 }
 
@@ -246,7 +246,7 @@ std::vector<TestFactor> linearChain(std::mt19937& rng) {
 TEST_CASE("Marginalising a linear-Gaussian chain keeps the exact solution and marginal covariance",
           "[estimator][marginalization]") {
   std::mt19937 rng(7);
-  const std::vector<TestFactor> factors = linearChain(rng);
+  const std::vector<TestFactor> factors = linear_chain(rng);
   constexpr int kBlocks = 5;
 
   // Full problem densely: r(x) = J x - c stacked, x* = (J^T J)^-1 J^T c, covariance (J^T J)^-1.
@@ -270,27 +270,27 @@ TEST_CASE("Marginalising a linear-Gaussian chain keeps the exact solution and ma
     std::vector<std::array<double, 3>> x(kBlocks);
     std::vector<double*> blocks;
     for (auto& xi : x) {
-      const Eigen::Vector3d v = randomMatrix(3, 1, rng, 2.0);  // arbitrary linearisation point
+      const Eigen::Vector3d v = random_matrix(3, 1, rng, 2.0);  // arbitrary linearisation point
       xi = {v.x(), v.y(), v.z()};
       blocks.push_back(xi.data());
     }
-    const auto info = marginalizeBlocks(factors, blocks, dropped);
-    REQUIRE(info->keptTangentSize() == 6);  // x1,x2 (or x2,x3) share a factor with the dropped blocks
+    const auto info = marginalize_blocks(factors, blocks, dropped);
+    REQUIRE(info->kept_tangent_size() == 6);  // x1,x2 (or x2,x3) share a factor with the dropped blocks
 
-    ceres::Problem problem(nonOwningOptions());
+    ceres::Problem problem(non_owning_options());
     MarginalizationFactor prior(info);
-    problem.AddResidualBlock(&prior, nullptr, info->keptBlocks());
-    addRemainingFactors(problem, factors, blocks, dropped);
+    problem.AddResidualBlock(&prior, nullptr, info->kept_blocks());
+    add_remaining_factors(problem, factors, blocks, dropped);
     for (int i = first_kept; i < kBlocks; ++i) x[i] = {0.0, 0.0, 0.0};  // start away from the optimum
     ceres::Solver::Summary summary;
-    ceres::Solve(tightSolverOptions(), &problem, &summary);
+    ceres::Solve(tight_solver_options(), &problem, &summary);
 
     const std::vector<double*> kept(blocks.begin() + first_kept, blocks.end());
     for (int i = first_kept; i < kBlocks; ++i) {
       INFO("dropped " << dropped.size() << " block(s), block " << i);
       CHECK((Eigen::Map<const Eigen::Vector3d>(x[i].data()) - x_star.segment<3>(3 * i)).cwiseAbs().maxCoeff() < 1e-8);
     }
-    const Eigen::MatrixXd Jr = denseJacobian(problem, kept);
+    const Eigen::MatrixXd Jr = dense_jacobian(problem, kept);
     const Eigen::MatrixXd reduced_cov = (Jr.transpose() * Jr).inverse();
     const int n = 3 * (kBlocks - first_kept);
     const Eigen::MatrixXd full_cov = covariance.bottomRightCorner(n, n);
@@ -309,51 +309,51 @@ TEST_CASE("Marginalising the first pose at the optimum keeps the pose graph's op
   std::vector<Eigen::Matrix3d> R_true;
   for (int i = 0; i < kPoses; ++i) {
     p_true.emplace_back(1.0 * i, 0.3 * std::sin(i), 0.1 * i * i);
-    R_true.push_back(so3::fromYawPitchRoll(0.4 * i, 0.1 * i, -0.05 * i));
+    R_true.push_back(so3::from_yaw_pitch_roll(0.4 * i, 0.1 * i, -0.05 * i));
   }
   // Noisy measurements, so the optimum fits none of them exactly.
   std::vector<TestFactor> factors;
-  factors.push_back({posePrior(makePose(p_true[0] + noisy3(), R_true[0] * so3::exp(noisy3())), 10.0), {0}, nullptr});
+  factors.push_back({pose_prior(make_pose(p_true[0] + noisy3(), R_true[0] * so3::exp(noisy3())), 10.0), {0}, nullptr});
   for (auto [i, j] : std::vector<std::pair<int, int>>{{0, 1}, {1, 2}, {2, 3}, {0, 2}, {1, 3}}) {
     const Eigen::Vector3d dp = R_true[i].transpose() * (p_true[j] - p_true[i]) + noisy3();
     const Eigen::Matrix3d dR = R_true[i].transpose() * R_true[j] * so3::exp(noisy3());
-    factors.push_back({relativePose(dp, dR, 3.0), {i, j}, nullptr});
+    factors.push_back({relative_pose(dp, dR, 3.0), {i, j}, nullptr});
   }
 
   std::vector<Pose> x(kPoses);
   std::vector<double*> blocks;
   for (int i = 0; i < kPoses; ++i) {
-    x[i] = makePose(p_true[i] + 3 * noisy3(), R_true[i] * so3::exp(3 * noisy3()));
+    x[i] = make_pose(p_true[i] + 3 * noisy3(), R_true[i] * so3::exp(3 * noisy3()));
     blocks.push_back(x[i].data());
   }
   PoseManifold manifold;
   {
-    ceres::Problem full(nonOwningOptions());
-    addRemainingFactors(full, factors, blocks, {});
+    ceres::Problem full(non_owning_options());
+    add_remaining_factors(full, factors, blocks, {});
     for (double* b : blocks) full.SetManifold(b, &manifold);
     ceres::Solver::Summary summary;
-    ceres::Solve(tightSolverOptions(), &full, &summary);
+    ceres::Solve(tight_solver_options(), &full, &summary);
     REQUIRE(summary.IsSolutionUsable());
   }
   const std::vector<Pose> optimum = x;
 
-  const auto info = marginalizeBlocks(factors, blocks, {0});
-  REQUIRE(info->keptBlocks() == std::vector<double*>{blocks[1], blocks[2]});
+  const auto info = marginalize_blocks(factors, blocks, {0});
+  REQUIRE(info->kept_blocks() == std::vector<double*>{blocks[1], blocks[2]});
 
-  ceres::Problem reduced(nonOwningOptions());
+  ceres::Problem reduced(non_owning_options());
   MarginalizationFactor prior(info);
-  reduced.AddResidualBlock(&prior, nullptr, info->keptBlocks());
-  addRemainingFactors(reduced, factors, blocks, {0});
+  reduced.AddResidualBlock(&prior, nullptr, info->kept_blocks());
+  add_remaining_factors(reduced, factors, blocks, {0});
   for (int i = 1; i < kPoses; ++i) {
-    x[i] = makePose(posOf(x[i].data()) + Eigen::Vector3d(0.2, -0.1, 0.15), rotOf(x[i].data()) * so3::exp(Eigen::Vector3d(0.1, -0.08, 0.12)));
+    x[i] = make_pose(pos_of(x[i].data()) + Eigen::Vector3d(0.2, -0.1, 0.15), rot_of(x[i].data()) * so3::exp(Eigen::Vector3d(0.1, -0.08, 0.12)));
     reduced.SetManifold(x[i].data(), &manifold);
   }
   ceres::Solver::Summary summary;
-  ceres::Solve(tightSolverOptions(), &reduced, &summary);
+  ceres::Solve(tight_solver_options(), &reduced, &summary);
   for (int i = 1; i < kPoses; ++i) {
     INFO("pose " << i);
-    CHECK((posOf(x[i].data()) - posOf(optimum[i].data())).norm() < 1e-6);
-    CHECK(so3::log(rotOf(optimum[i].data()).transpose() * rotOf(x[i].data())).norm() < 1e-6);
+    CHECK((pos_of(x[i].data()) - pos_of(optimum[i].data())).norm() < 1e-6);
+    CHECK(so3::log(rot_of(optimum[i].data()).transpose() * rot_of(x[i].data())).norm() < 1e-6);
   }
 }
 
@@ -361,38 +361,38 @@ TEST_CASE("MarginalizationFactor Jacobians match numeric differentiation through
           "[estimator][marginalization]") {
   std::mt19937 rng(3);
   // Pose 0 tied to pose 1, a 9-dim speed-bias-like block and pose 2; marginalise pose 0.
-  Pose t0 = makePose({0, 0, 0}, Eigen::Matrix3d::Identity());
-  Pose t1 = makePose({1, 0.2, -0.1}, so3::exp({0.1, 0.3, -0.2}));
-  Pose t2 = makePose({2, 0.1, 0.3}, so3::exp({-0.2, 0.6, 0.1}));
+  Pose t0 = make_pose({0, 0, 0}, Eigen::Matrix3d::Identity());
+  Pose t1 = make_pose({1, 0.2, -0.1}, so3::exp({0.1, 0.3, -0.2}));
+  Pose t2 = make_pose({2, 0.1, 0.3}, so3::exp({-0.2, 0.6, 0.1}));
   std::array<double, 9> sb{};
   for (double& v : sb) v = std::uniform_real_distribution<double>(-1, 1)(rng);
   auto sb_factor = std::make_shared<NumericTangentCost>(
       [](const std::vector<const double*>& x) {
         Eigen::VectorXd r(9);
-        r.head<3>() = rotOf(x[0]).transpose() * Eigen::Map<const Eigen::Vector3d>(x[1]) - Eigen::Vector3d(1, 0, 0);
+        r.head<3>() = rot_of(x[0]).transpose() * Eigen::Map<const Eigen::Vector3d>(x[1]) - Eigen::Vector3d(1, 0, 0);
         r.tail<6>() = 2.0 * Eigen::Map<const Eigen::Matrix<double, 6, 1>>(x[1] + 3);
         return r;
       },
       std::vector<int>{7, 9}, 9);
   const std::vector<TestFactor> factors{
-      {posePrior(makePose({0.1, 0, 0}, so3::exp({0, 0, 0.1})), 5.0), {0}, nullptr},
-      {relativePose({1, 0, 0}, so3::exp({0.1, 0.2, -0.3}), 2.0), {0, 1}, nullptr},
+      {pose_prior(make_pose({0.1, 0, 0}, so3::exp({0, 0, 0.1})), 5.0), {0}, nullptr},
+      {relative_pose({1, 0, 0}, so3::exp({0.1, 0.2, -0.3}), 2.0), {0, 1}, nullptr},
       {sb_factor, {0, 2}, nullptr},
-      {relativePose({2, 0, 0}, so3::exp({-0.1, 0.5, 0.2}), 2.0), {0, 3}, nullptr},
+      {relative_pose({2, 0, 0}, so3::exp({-0.1, 0.5, 0.2}), 2.0), {0, 3}, nullptr},
   };
   const std::vector<double*> blocks{t0.data(), t1.data(), sb.data(), t2.data()};
-  const auto info = marginalizeBlocks(factors, blocks, {0});
+  const auto info = marginalize_blocks(factors, blocks, {0});
   MarginalizationFactor prior(info);
   REQUIRE(prior.parameter_block_sizes() == std::vector<int32_t>{7, 9, 7});
   const int rows = prior.num_residuals();
-  REQUIRE(rows == info->keptTangentSize());  // t1 (6) + sb (9) + t2 (6), full rank
+  REQUIRE(rows == info->kept_tangent_size());  // t1 (6) + sb (9) + t2 (6), full rank
 
   // At the linearisation point the residual is r0.
   {
     Eigen::VectorXd r(rows);
     const double* params[] = {t1.data(), sb.data(), t2.data()};
     prior.Evaluate(params, r.data(), nullptr);
-    CHECK((r - info->linearizedResidual()).cwiseAbs().maxCoeff() < 1e-12);
+    CHECK((r - info->linearized_residual()).cwiseAbs().maxCoeff() < 1e-12);
   }
 
   // Far from it (rotations moved ~0.5 rad), analytic vs numeric.
@@ -405,16 +405,16 @@ TEST_CASE("MarginalizationFactor Jacobians match numeric differentiation through
   std::array<double, 9> sbm = sb;
   for (double& v : sbm) v += 0.3;
   const test::BlockValues params{{t1m.begin(), t1m.end()}, {sbm.begin(), sbm.end()}, {t2m.begin(), t2m.end()}};
-  test::requireJacobiansMatchNumeric(prior, params, {test::Block::Pose, test::Block::Euclidean, test::Block::Pose});
+  test::require_jacobians_match_numeric(prior, params, {test::Block::Pose, test::Block::Euclidean, test::Block::Pose});
   const RowMajor analytic0 = test::evaluate(prior, params).jacobians[0];
   // The identity approximation of d Log / dθ would be off by far more than the tolerance here.
-  CHECK((analytic0.middleCols<3>(3) - info->linearizedJacobian().middleCols<3>(3)).cwiseAbs().maxCoeff() > 1e-3);
+  CHECK((analytic0.middleCols<3>(3) - info->linearized_jacobian().middleCols<3>(3)).cwiseAbs().maxCoeff() > 1e-3);
 }
 
 TEST_CASE("Dropping a block that shares no factor with the kept ones leaves the prior unchanged",
           "[estimator][marginalization]") {
   std::mt19937 rng(5);
-  const std::vector<TestFactor> chain = linearChain(rng);
+  const std::vector<TestFactor> chain = linear_chain(rng);
   std::vector<std::array<double, 3>> x(6, std::array<double, 3>{0.3, -0.2, 0.5});
   std::vector<double*> blocks;
   for (auto& xi : x) blocks.push_back(xi.data());
@@ -422,13 +422,13 @@ TEST_CASE("Dropping a block that shares no factor with the kept ones leaves the 
   with_isolated.push_back({std::make_shared<LinearFactor>(std::vector<Eigen::MatrixXd>{Eigen::MatrixXd::Identity(3, 3)},
                                                           Eigen::VectorXd::Ones(3)),
                            {5}, nullptr});
-  const auto plain = marginalizeBlocks(chain, blocks, {0});
-  const auto isolated = marginalizeBlocks(with_isolated, blocks, {0, 5});
-  REQUIRE(isolated->keptBlocks() == plain->keptBlocks());
-  const Eigen::MatrixXd& J1 = plain->linearizedJacobian();
-  const Eigen::MatrixXd& J2 = isolated->linearizedJacobian();
+  const auto plain = marginalize_blocks(chain, blocks, {0});
+  const auto isolated = marginalize_blocks(with_isolated, blocks, {0, 5});
+  REQUIRE(isolated->kept_blocks() == plain->kept_blocks());
+  const Eigen::MatrixXd& J1 = plain->linearized_jacobian();
+  const Eigen::MatrixXd& J2 = isolated->linearized_jacobian();
   CHECK((J1.transpose() * J1 - J2.transpose() * J2).cwiseAbs().maxCoeff() < 1e-10);
-  CHECK((J1.transpose() * plain->linearizedResidual() - J2.transpose() * isolated->linearizedResidual())
+  CHECK((J1.transpose() * plain->linearized_residual() - J2.transpose() * isolated->linearized_residual())
             .cwiseAbs().maxCoeff() < 1e-10);
 }
 
@@ -448,12 +448,12 @@ TEST_CASE("A Huber loss on a marginalised factor weights its information by rho'
         {std::make_shared<LinearFactor>(std::vector<Eigen::MatrixXd>{Eigen::MatrixXd::Ones(1, 1)}, Eigen::VectorXd::Constant(1, m)),
          {0}, std::make_shared<ceres::HuberLoss>(a)},
     };
-    const auto info = marginalizeBlocks(factors, {&x, &y}, {0});
-    const Eigen::MatrixXd& J = info->linearizedJacobian();
+    const auto info = marginalize_blocks(factors, {&x, &y}, {0});
+    const Eigen::MatrixXd& J = info->linearized_jacobian();
     INFO("Huber a = " << a << ", rho' = " << rho1);
     REQUIRE(J.rows() == 1);
     CHECK((J.transpose() * J)(0, 0) == Approx(rho1 / (1.0 + rho1)).epsilon(1e-12));
-    CHECK((J.transpose() * info->linearizedResidual())(0) == Approx(rho1 * (r_b - r_a) / (1.0 + rho1)).epsilon(1e-12));
+    CHECK((J.transpose() * info->linearized_residual())(0) == Approx(rho1 * (r_b - r_a) / (1.0 + rho1)).epsilon(1e-12));
   }
 }
 
@@ -476,8 +476,8 @@ TEST_CASE("Robust losses enter the prior exactly as Ceres' own Gauss-Newton syst
   std::array<double, 2> x{1.5, -0.7}, y{0.4, 0.9};
   auto linear = [&rng](int blocks) {
     std::vector<Eigen::MatrixXd> a;
-    for (int k = 0; k < blocks; ++k) a.push_back(randomMatrix(2, 2, rng) + (k == 0 ? 2.0 : -1.0) * Eigen::MatrixXd::Identity(2, 2));
-    return std::make_shared<LinearFactor>(a, Eigen::VectorXd(randomMatrix(2, 1, rng)));
+    for (int k = 0; k < blocks; ++k) a.push_back(random_matrix(2, 2, rng) + (k == 0 ? 2.0 : -1.0) * Eigen::MatrixXd::Identity(2, 2));
+    return std::make_shared<LinearFactor>(a, Eigen::VectorXd(random_matrix(2, 1, rng)));
   };
   const std::vector<TestFactor> factors{
       {linear(2), {0, 1}, std::make_shared<StiffeningLoss>()},
@@ -486,14 +486,14 @@ TEST_CASE("Robust losses enter the prior exactly as Ceres' own Gauss-Newton syst
   };
   const std::vector<double*> blocks{x.data(), y.data()};
 
-  const auto [H, b] = denseSystem(factors, blocks, blocks);
+  const auto [H, b] = dense_system(factors, blocks, blocks);
   const Eigen::Matrix2d h_star = H.bottomRightCorner<2, 2>() - H.bottomLeftCorner<2, 2>() * H.topLeftCorner<2, 2>().inverse() * H.topRightCorner<2, 2>();
   const Eigen::Vector2d b_star = b.tail<2>() - H.bottomLeftCorner<2, 2>() * H.topLeftCorner<2, 2>().inverse() * b.head<2>();
 
-  const auto info = marginalizeBlocks(factors, blocks, {0});
-  const Eigen::MatrixXd& Jm = info->linearizedJacobian();
+  const auto info = marginalize_blocks(factors, blocks, {0});
+  const Eigen::MatrixXd& Jm = info->linearized_jacobian();
   CHECK((Jm.transpose() * Jm - h_star).cwiseAbs().maxCoeff() < 1e-10);
-  CHECK((Jm.transpose() * info->linearizedResidual() - b_star).cwiseAbs().maxCoeff() < 1e-10);
+  CHECK((Jm.transpose() * info->linearized_residual() - b_star).cwiseAbs().maxCoeff() < 1e-10);
   // Both losses are really active here (else this test would not exercise the corrections).
   double rho[3];
   Eigen::VectorXd r(2);
@@ -522,10 +522,10 @@ TEST_CASE("Scalar dropped blocks (inverse depths) are eliminated to the same Sch
     auto factor = [&](std::vector<int> idx, int rows, std::shared_ptr<ceres::LossFunction> loss = nullptr) {
       std::vector<Eigen::MatrixXd> a;
       for (int i : idx) {
-        a.push_back(randomMatrix(rows, sizes[i], rng));
+        a.push_back(random_matrix(rows, sizes[i], rng));
         if (uninformative && i == 6) a.back().setZero();
       }
-      return TestFactor{std::make_shared<LinearFactor>(a, Eigen::VectorXd(randomMatrix(rows, 1, rng))), idx, loss};
+      return TestFactor{std::make_shared<LinearFactor>(a, Eigen::VectorXd(random_matrix(rows, 1, rng))), idx, loss};
     };
     std::vector<TestFactor> factors{
         factor({0}, 3),  // p alone
@@ -542,13 +542,13 @@ TEST_CASE("Scalar dropped blocks (inverse depths) are eliminated to the same Sch
         factor({1, 8}, 1),
     };
     const std::set<int> dropped{0, 3, 4, 5, 6, 7, 8};
-    const auto info = marginalizeBlocks(factors, blocks, dropped);
-    REQUIRE(info->keptBlocks() == std::vector<double*>{k0.data(), k1.data()});
+    const auto info = marginalize_blocks(factors, blocks, dropped);
+    REQUIRE(info->kept_blocks() == std::vector<double*>{k0.data(), k1.data()});
 
     // Reference: Ceres' own Jacobian and gradient, Schur complement with a pseudo-inverse of H_mm.
     std::vector<double*> order;  // dropped first, then kept
     for (int i : {0, 3, 4, 5, 6, 7, 8, 1, 2}) order.push_back(blocks[i]);
-    const auto [H, b] = denseSystem(factors, blocks, order);
+    const auto [H, b] = dense_system(factors, blocks, order);
     const int m = 9, n = 5;
     const Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> eig(H.topLeftCorner(m, m));
     const Eigen::VectorXd inv = (eig.eigenvalues().array() > 1e-8).select(eig.eigenvalues().array().inverse(), 0.0);
@@ -556,15 +556,15 @@ TEST_CASE("Scalar dropped blocks (inverse depths) are eliminated to the same Sch
     const Eigen::MatrixXd h_star = H.bottomRightCorner(n, n) - H.bottomLeftCorner(n, m) * hmm_inv * H.topRightCorner(m, n);
     const Eigen::VectorXd b_star = b.tail(n) - H.bottomLeftCorner(n, m) * hmm_inv * b.head(m);
 
-    const Eigen::MatrixXd& Jm = info->linearizedJacobian();
+    const Eigen::MatrixXd& Jm = info->linearized_jacobian();
     INFO("uninformative d3: " << uninformative);
     CHECK((Jm.transpose() * Jm - h_star).cwiseAbs().maxCoeff() < 1e-9 * h_star.cwiseAbs().maxCoeff());
-    CHECK((Jm.transpose() * info->linearizedResidual() - b_star).cwiseAbs().maxCoeff() <
+    CHECK((Jm.transpose() * info->linearized_residual() - b_star).cwiseAbs().maxCoeff() <
           1e-9 * (1.0 + b_star.cwiseAbs().maxCoeff()));
   }
 }
 
-TEST_CASE("keptBlocks follows the linearized column order and applies the address shift",
+TEST_CASE("kept_blocks follows the linearized column order and applies the address shift",
           "[estimator][marginalization]") {
   // Kept blocks of sizes 3, 1, 2 with priors of distinct weights, plus a dropped block d linked to a.
   std::array<double, 3> c{1, 2, 3};
@@ -596,18 +596,18 @@ TEST_CASE("keptBlocks follows the linearized column order and applies the addres
   info.linearize();
   info.marginalize();
 
-  REQUIRE(info.keptBlocks() == std::vector<double*>{c.data(), a.data(), b.data()});
-  REQUIRE(info.keptSizes() == std::vector<int>{3, 1, 2});
-  REQUIRE(info.keptTangentOffsets() == std::vector<int>{0, 3, 4});
+  REQUIRE(info.kept_blocks() == std::vector<double*>{c.data(), a.data(), b.data()});
+  REQUIRE(info.kept_sizes() == std::vector<int>{3, 1, 2});
+  REQUIRE(info.kept_tangent_offsets() == std::vector<int>{0, 3, 4});
   // The diagonal of J^T J identifies each block: c -> 9, b -> 4, a -> prior 1 + link 1 minus the Schur
   // term of d (H_dd = I + 1 1^T, H_da = 1: 1^T H_dd^-1 1 = 2/3).
-  const Eigen::MatrixXd H = info.linearizedJacobian().transpose() * info.linearizedJacobian();
+  const Eigen::MatrixXd H = info.linearized_jacobian().transpose() * info.linearized_jacobian();
   CHECK((H.diagonal() - (Eigen::VectorXd(6) << 9, 9, 9, 1.0 + 1.0 - 2.0 / 3.0, 4, 4).finished()).cwiseAbs().maxCoeff() < 1e-12);
 
   std::array<double, 3> c_new{};
   std::array<double, 2> b_new{};
   const std::unordered_map<const double*, double*> shift{{c.data(), c_new.data()}, {b.data(), b_new.data()}};
-  CHECK(info.keptBlocks(shift) == std::vector<double*>{c_new.data(), a.data(), b_new.data()});
+  CHECK(info.kept_blocks(shift) == std::vector<double*>{c_new.data(), a.data(), b_new.data()});
 }
 
 TEST_CASE("Marginalising every block throws", "[estimator][marginalization]") {

@@ -23,12 +23,12 @@ struct Transform {
   Eigen::Vector3d p;
   Eigen::Matrix3d R;
   Eigen::Vector3d apply(const Eigen::Vector3d& x) const { return R * x + p; }
-  Eigen::Vector3d applyInverse(const Eigen::Vector3d& x) const { return R.transpose() * (x - p); }
+  Eigen::Vector3d apply_inverse(const Eigen::Vector3d& x) const { return R.transpose() * (x - p); }
   Transform compose(const Transform& o) const { return {R * o.p + p, R * o.R}; }
-  std::vector<double> block() const { return poseBlock(p, R); }
+  std::vector<double> block() const { return pose_block(p, R); }
 };
 
-Eigen::Vector3d randomVector(std::mt19937& rng, double scale) {
+Eigen::Vector3d random_vector(std::mt19937& rng, double scale) {
   std::uniform_real_distribution<double> u(-scale, scale);
   return Eigen::Vector3d(u(rng), u(rng), u(rng));
 }
@@ -44,31 +44,31 @@ struct Scene {
   Eigen::Vector2d cam1_i;  ///< true observation in cam1 at i
 
   /// The feature in camera `T_bc` of body pose `T_wb`.
-  Eigen::Vector3d inCamera(const Transform& T_wb, const Transform& T_bc) const {
-    return T_wb.compose(T_bc).applyInverse(P_w);
+  Eigen::Vector3d in_camera(const Transform& T_wb, const Transform& T_bc) const {
+    return T_wb.compose(T_bc).apply_inverse(P_w);
   }
 };
 
 Eigen::Vector2d normalized(const Eigen::Vector3d& P) { return P.head<2>() / P.z(); }
 
-Scene randomScene(std::mt19937& rng) {
+Scene random_scene(std::mt19937& rng) {
   std::uniform_real_distribution<double> u(-1.0, 1.0);
   for (;;) {
     Scene s;
-    s.T_wi = {randomVector(rng, 5.0), so3::exp(randomVector(rng, 3.0))};
+    s.T_wi = {random_vector(rng, 5.0), so3::exp(random_vector(rng, 3.0))};
     // Camera looking along body x (z_cam = x_body), tilted a little, as on a typical rig.
     Eigen::Matrix3d cam_to_body;
     cam_to_body << 0, 0, 1, -1, 0, 0, 0, -1, 0;
-    s.T_bc0 = {randomVector(rng, 0.1), cam_to_body * so3::exp(randomVector(rng, 0.1))};
-    const Transform T_c0c1{Eigen::Vector3d(0.11, 0.0, 0.0) + randomVector(rng, 0.01),
-                           so3::exp(randomVector(rng, 0.02))};
+    s.T_bc0 = {random_vector(rng, 0.1), cam_to_body * so3::exp(random_vector(rng, 0.1))};
+    const Transform T_c0c1{Eigen::Vector3d(0.11, 0.0, 0.0) + random_vector(rng, 0.01),
+                           so3::exp(random_vector(rng, 0.02))};
     s.T_bc1 = s.T_bc0.compose(T_c0c1);
-    s.T_wj = s.T_wi.compose(Transform{randomVector(rng, 0.4), so3::exp(randomVector(rng, 0.2))});
+    s.T_wj = s.T_wi.compose(Transform{random_vector(rng, 0.4), so3::exp(random_vector(rng, 0.2))});
     s.xy_i = Eigen::Vector2d(0.4 * u(rng), 0.3 * u(rng));
     s.inv_depth = 1.0 / (4.0 + 3.0 * u(rng));
     s.P_w = s.T_wi.compose(s.T_bc0).apply(Eigen::Vector3d(s.xy_i.x(), s.xy_i.y(), 1.0) / s.inv_depth);
-    const Eigen::Vector3d c0j = s.inCamera(s.T_wj, s.T_bc0), c1j = s.inCamera(s.T_wj, s.T_bc1),
-                          c1i = s.inCamera(s.T_wi, s.T_bc1);
+    const Eigen::Vector3d c0j = s.in_camera(s.T_wj, s.T_bc0), c1j = s.in_camera(s.T_wj, s.T_bc1),
+                          c1i = s.in_camera(s.T_wi, s.T_bc1);
     if (c0j.z() < 1.0 || c1j.z() < 1.0 || c1i.z() < 1.0) continue;  // keep the point well in front
     s.cam0_j = normalized(c0j);
     s.cam1_j = normalized(c1j);
@@ -77,7 +77,7 @@ Scene randomScene(std::mt19937& rng) {
   }
 }
 
-Eigen::Vector2d noise(std::mt19937& rng) { return randomVector(rng, 0.02).head<2>(); }
+Eigen::Vector2d noise(std::mt19937& rng) { return random_vector(rng, 0.02).head<2>(); }
 
 }  // namespace
 
@@ -86,19 +86,19 @@ TEST_CASE("reprojection factor Jacobians match numeric differences at random sta
   std::mt19937 rng(42);
   const double weight = 0.7;  // Jacobians must carry the weight too
   for (int trial = 0; trial < 8; ++trial) {
-    const Scene s = randomScene(rng);
+    const Scene s = random_scene(rng);
     const double* w = trial % 2 == 0 ? nullptr : &weight;
     INFO("trial " << trial);
     // Observations off the truth so that residuals (and the terms they multiply) are non-zero.
     const ProjectionTwoFrameOneCamFactor one_cam(s.xy_i, s.cam0_j + noise(rng), kSqrtInfo, w);
-    requireJacobiansMatchNumeric(one_cam, {s.T_wi.block(), s.T_wj.block(), s.T_bc0.block(), {s.inv_depth}},
+    require_jacobians_match_numeric(one_cam, {s.T_wi.block(), s.T_wj.block(), s.T_bc0.block(), {s.inv_depth}},
                                  {Block::Pose, Block::Pose, Block::Pose, Block::Euclidean});
     const ProjectionTwoFrameTwoCamFactor two_cam(s.xy_i, s.cam1_j + noise(rng), kSqrtInfo, w);
-    requireJacobiansMatchNumeric(
+    require_jacobians_match_numeric(
         two_cam, {s.T_wi.block(), s.T_wj.block(), s.T_bc0.block(), s.T_bc1.block(), {s.inv_depth}},
         {Block::Pose, Block::Pose, Block::Pose, Block::Pose, Block::Euclidean});
     const ProjectionOneFrameTwoCamFactor stereo(s.xy_i, s.cam1_i + noise(rng), kSqrtInfo, w);
-    requireJacobiansMatchNumeric(stereo, {s.T_bc0.block(), s.T_bc1.block(), {s.inv_depth}},
+    require_jacobians_match_numeric(stereo, {s.T_bc0.block(), s.T_bc1.block(), {s.inv_depth}},
                                  {Block::Pose, Block::Pose, Block::Euclidean});
   }
 }
@@ -107,7 +107,7 @@ TEST_CASE("reprojection residuals vanish at the true state and grow off it",
           "[estimator][factors][reprojection]") {
   std::mt19937 rng(1);
   for (int trial = 0; trial < 10; ++trial) {
-    const Scene s = randomScene(rng);
+    const Scene s = random_scene(rng);
     const ProjectionTwoFrameOneCamFactor one_cam(s.xy_i, s.cam0_j, kSqrtInfo);
     const ProjectionTwoFrameTwoCamFactor two_cam(s.xy_i, s.cam1_j, kSqrtInfo);
     const ProjectionOneFrameTwoCamFactor stereo(s.xy_i, s.cam1_i, kSqrtInfo);
@@ -130,7 +130,7 @@ TEST_CASE("reprojection residuals vanish at the true state and grow off it",
 TEST_CASE("the DynaVINS weight scales residual and Jacobians and is read at Evaluate time",
           "[estimator][factors][reprojection]") {
   std::mt19937 rng(9);
-  const Scene s = randomScene(rng);
+  const Scene s = random_scene(rng);
   const Eigen::Vector2d obs0 = s.cam0_j + noise(rng), obs1 = s.cam1_j + noise(rng), obs_s = s.cam1_i + noise(rng);
   const std::vector<std::vector<double>> p_one = {s.T_wi.block(), s.T_wj.block(), s.T_bc0.block(), {s.inv_depth}};
   const std::vector<std::vector<double>> p_two = {s.T_wi.block(), s.T_wj.block(), s.T_bc0.block(),
@@ -164,7 +164,7 @@ TEST_CASE("the DynaVINS weight scales residual and Jacobians and is read at Eval
 TEST_CASE("a Ceres solve with two-frame reprojection factors recovers pose_j",
           "[estimator][factors][reprojection]") {
   std::mt19937 rng(2024);
-  const Scene base = randomScene(rng);  // poses and rig; features drawn below
+  const Scene base = random_scene(rng);  // poses and rig; features drawn below
   std::uniform_real_distribution<double> u(-1.0, 1.0);
   const Transform T_wc0i = base.T_wi.compose(base.T_bc0), T_wc0j = base.T_wj.compose(base.T_bc0);
 
@@ -178,7 +178,7 @@ TEST_CASE("a Ceres solve with two-frame reprojection factors recovers pose_j",
     const Eigen::Vector2d xy_i(0.5 * u(rng), 0.4 * u(rng));
     const double inv_depth = 1.0 / (5.0 + 4.0 * u(rng));
     const Eigen::Vector3d P_ci = Eigen::Vector3d(xy_i.x(), xy_i.y(), 1.0) / inv_depth;
-    const Eigen::Vector3d P_cj = T_wc0j.applyInverse(T_wc0i.apply(P_ci));
+    const Eigen::Vector3d P_cj = T_wc0j.apply_inverse(T_wc0i.apply(P_ci));
     if (P_cj.z() < 1.0) continue;
     inv_depths.push_back(inv_depth);
     observations.emplace_back(xy_i, normalized(P_cj));

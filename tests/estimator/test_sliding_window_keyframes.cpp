@@ -1,5 +1,5 @@
 // SlidingWindowEstimator's keyframes for the loop closer (WindowEstimate::finished_keyframes and
-// flushKeyframes()), on the real EuRoC clip driven by hand: EurocDataset -> StereoTracker ->
+// flush_keyframes()), on the real EuRoC clip driven by hand: EurocDataset -> StereoTracker ->
 // ImuIntervalBuilder -> estimator, one frame at a time (deterministic). Checks that every keyframe goes out
 // once, in time order, only frames the window kept; its pose is the window's (close to the frame's own
 // estimate), its points and weights are sane, and its image is the tracker's left image, not a copy, held
@@ -33,7 +33,7 @@ struct ClipRun {
   std::vector<WindowEstimate> estimates;   // finished_keyframes moved out into `finished`
   std::vector<Keyframe> finished;          // from the estimates, in arrival order
   std::vector<int> finished_per_estimate;  // how many each estimate carried
-  std::vector<Keyframe> flushed;           // flushKeyframes() after the last frame
+  std::vector<Keyframe> flushed;           // flush_keyframes() after the last frame
   std::vector<Keyframe> flushed_again;     // a second flush: must be empty
   std::map<int64_t, cv::Mat> left;         // the loaded left image of every frame, by time
   int max_images_held = 0;                 // most left images the estimator held at once (beyond this test's)
@@ -41,38 +41,38 @@ struct ClipRun {
 };
 
 /// Left images referenced by someone besides `run.left` (the estimator's window, the keyframes kept here).
-int imagesHeldElsewhere(const ClipRun& run) {
+int images_held_elsewhere(const ClipRun& run) {
   int n = 0;
   for (const auto& [t, m] : run.left) n += (m.u != nullptr && m.u->refcount > 1) ? 1 : 0;
   return n;
 }
 
 /// With `drop_imu_at` >= 0, that frame comes without its IMU interval (an outage: the estimator resets).
-ClipRun runClip(int drop_imu_at = -1) {
+ClipRun run_clip(int drop_imu_at = -1) {
   ClipRun run;
   run.options = EstimatorOptions::load(kConfig);
   run.options.max_solver_time = 1e9;  // iteration budget only: the run must not depend on the machine
   const io::EurocDataset data(kClip);
-  StereoTracker tracker(TrackerOptions::from(run.options), run.options.cameras.at(0), run.options.cameras.at(1));
+  tracker::StereoTracker tracker(tracker::TrackerOptions::from(run.options), run.options.cameras.at(0), run.options.cameras.at(1));
   SlidingWindowEstimator est(run.options, EstimatorMode{});
 
   // Every interval first (the whole clip's IMU is at hand), keyed by its start frame.
-  ImuIntervalBuilderOptions bo;
+  imu::ImuIntervalBuilderOptions bo;
   bo.noise.acc_n = run.options.acc_n;
   bo.noise.gyr_n = run.options.gyr_n;
   bo.noise.acc_w = run.options.acc_w;
   bo.noise.gyr_w = run.options.gyr_w;
-  ImuIntervalBuilder builder(bo);
+  imu::ImuIntervalBuilder builder(bo);
   std::map<int64_t, PreintegratedInterval> intervals;
   std::size_t next_imu = 0;
   const auto& imu = data.imu();
   for (const io::EurocFrame& f : data.frames()) {
     while (next_imu < imu.size() && imu[next_imu].t_ns <= f.t_ns)
-      for (auto& iv : builder.addImu(imu[next_imu++])) intervals[iv.t_begin_ns] = std::move(iv);
-    for (auto& iv : builder.addFrame(f.t_ns)) intervals[iv.t_begin_ns] = std::move(iv);
+      for (auto& iv : builder.add_imu(imu[next_imu++])) intervals[iv.t_begin_ns] = std::move(iv);
+    for (auto& iv : builder.add_frame(f.t_ns)) intervals[iv.t_begin_ns] = std::move(iv);
   }
   while (next_imu < imu.size())
-    for (auto& iv : builder.addImu(imu[next_imu++])) intervals[iv.t_begin_ns] = std::move(iv);
+    for (auto& iv : builder.add_imu(imu[next_imu++])) intervals[iv.t_begin_ns] = std::move(iv);
 
   const int64_t first_imu_ns = imu.front().t_ns;
   int64_t prev_t = -1;
@@ -98,17 +98,17 @@ ClipRun runClip(int drop_imu_at = -1) {
     // Keyframes handed out hold their images too; count only the estimator's.
     std::vector<cv::Mat> kept_images;
     for (Keyframe& kf : run.finished) kept_images.push_back(std::exchange(kf.image, cv::Mat()));
-    run.max_images_held = std::max(run.max_images_held, imagesHeldElsewhere(run));
+    run.max_images_held = std::max(run.max_images_held, images_held_elsewhere(run));
     for (std::size_t k = 0; k < kept_images.size(); ++k) run.finished[k].image = kept_images[k];
     run.estimates.push_back(std::move(e));
   }
-  run.flushed = est.flushKeyframes();
-  run.flushed_again = est.flushKeyframes();
+  run.flushed = est.flush_keyframes();
+  run.flushed_again = est.flush_keyframes();
   return run;
 }
 
-const ClipRun& clipRun() {
-  static const ClipRun kRun = runClip();
+const ClipRun& clip_run() {
+  static const ClipRun kRun = run_clip();
   return kRun;
 }
 
@@ -116,7 +116,7 @@ const ClipRun& clipRun() {
 
 TEST_CASE("keyframes leave the window once each, in time order, only frames the window kept",
           "[estimator][keyframes]") {
-  const ClipRun& run = clipRun();
+  const ClipRun& run = clip_run();
   int tracking = 0;
   for (const auto& e : run.estimates) tracking += e.status == EstimatorStatus::Tracking ? 1 : 0;
   REQUIRE(tracking > 50);
@@ -157,7 +157,7 @@ TEST_CASE("keyframes leave the window once each, in time order, only frames the 
 
 TEST_CASE("a keyframe carries its window pose, the extrinsic, weighted points and the left image",
           "[estimator][keyframes]") {
-  const ClipRun& run = clipRun();
+  const ClipRun& run = clip_run();
   std::map<int64_t, const WindowEstimate*> by_time;
   for (const auto& e : run.estimates) by_time[e.t_ns] = &e;
   std::vector<Keyframe> all = run.finished;
@@ -216,7 +216,7 @@ TEST_CASE("a keyframe carries its window pose, the extrinsic, weighted points an
 }
 
 TEST_CASE("the estimator holds left images only while their frames are in the window", "[estimator][keyframes]") {
-  const ClipRun& run = clipRun();
+  const ClipRun& run = clip_run();
   // window_size + 1 slots, plus the one being tracked and estimated
   CHECK(run.max_images_held <= run.options.window_size + 2);
   CHECK(run.max_images_held >= run.options.window_size);
@@ -225,7 +225,7 @@ TEST_CASE("the estimator holds left images only while their frames are in the wi
 
 TEST_CASE("a reset found before the solve hands out the window's keyframes with the Reset estimate",
           "[estimator][keyframes]") {
-  const ClipRun run = runClip(60);
+  const ClipRun run = run_clip(60);
   REQUIRE(run.estimates.at(59).status == EstimatorStatus::Tracking);
   REQUIRE(run.estimates.at(60).status == EstimatorStatus::Reset);
   // The window's keyframes (all but its newest frame, estimate 59) with the poses of the last Tracking solve.

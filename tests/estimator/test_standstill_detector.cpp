@@ -1,4 +1,4 @@
-// checkStandstill: a camera that only rotates is at rest, one that moves a few centimetres is not, a
+// check_standstill: a camera that only rotates is at rest, one that moves a few centimetres is not, a
 // moving object filling most of the view hides the standstill until the robust BA rejects its features,
 // and the speed and feature-count guards hold. Geometry is exact (projections of known points).
 #include <catch2/catch.hpp>
@@ -29,7 +29,7 @@ TrackedFeature observe(int64_t id, const Camera& c, const Eigen::Vector3d& p_w) 
 
 /// Two frames of `n_static` static points 3-10 m ahead, plus `n_moving` points of an object 3 m ahead that
 /// moves `object_step` between the frames; the camera goes from `a` to `b`.
-WindowFeatures twoFrames(const Camera& a, const Camera& b, int n_static, int n_moving,
+WindowFeatures two_frames(const Camera& a, const Camera& b, int n_static, int n_moving,
                          const Eigen::Vector3d& object_step) {
   std::mt19937 rng(5);
   std::uniform_real_distribution<double> xy(-2, 2), z(3, 10);
@@ -43,56 +43,56 @@ WindowFeatures twoFrames(const Camera& a, const Camera& b, int n_static, int n_m
       const Eigen::Vector3d p = pts[i] + (i >= n_static && slot == 1 ? object_step : Eigen::Vector3d::Zero());
       f.features.push_back(observe(i, slot == 0 ? a : b, p));
     }
-    wf.addFrame(slot, f, 10.0 / kNominalFocalPx, false);
+    wf.add_frame(slot, f, 10.0 / kNominalFocalPx, false);
   }
   return wf;
 }
 
-Eigen::Matrix3d prevFromNew(const Camera& a, const Camera& b) { return a.R.transpose() * b.R; }
+Eigen::Matrix3d prev_from_new(const Camera& a, const Camera& b) { return a.R.transpose() * b.R; }
 
 }  // namespace
 
-TEST_CASE("checkStandstill: a rotating camera stands still, a translating one does not", "[standstill]") {
+TEST_CASE("check_standstill: a rotating camera stands still, a translating one does not", "[standstill]") {
   const StandstillOptions o;
   Camera a, b;
   b.R = so3::exp(Eigen::Vector3d(0.01, 0.03, -0.02));  // ~2 degrees in 50 ms, no translation
-  const StandstillCheck rot = checkStandstill(twoFrames(a, b, 60, 0, Eigen::Vector3d::Zero()), 1, prevFromNew(a, b), 0.0, o);
+  const StandstillCheck rot = check_standstill(two_frames(a, b, 60, 0, Eigen::Vector3d::Zero()), 1, prev_from_new(a, b), 0.0, o);
   CHECK(rot.still);
   CHECK(rot.features == 60);
   CHECK(rot.median_disparity_px < 1e-9);
 
   b.p = Eigen::Vector3d(0.03, 0, 0);  // 3 cm sideways (0.6 m/s at 20 Hz): several pixels at 3-10 m
-  const StandstillCheck moved = checkStandstill(twoFrames(a, b, 60, 0, Eigen::Vector3d::Zero()), 1, prevFromNew(a, b), 0.0, o);
+  const StandstillCheck moved = check_standstill(two_frames(a, b, 60, 0, Eigen::Vector3d::Zero()), 1, prev_from_new(a, b), 0.0, o);
   CHECK_FALSE(moved.still);
   CHECK(moved.median_disparity_px > 1.0);
 }
 
-TEST_CASE("checkStandstill: a moving object hides the standstill until its features are rejected", "[standstill]") {
+TEST_CASE("check_standstill: a moving object hides the standstill until its features are rejected", "[standstill]") {
   const StandstillOptions o;
   const Camera a, b;
   // 80 of 110 features on an object moving 10 cm between the frames (2 m/s) 3 m ahead.
-  WindowFeatures wf = twoFrames(a, b, 30, 80, Eigen::Vector3d(0.1, 0, 0));
+  WindowFeatures wf = two_frames(a, b, 30, 80, Eigen::Vector3d(0.1, 0, 0));
   const Eigen::Matrix3d I = Eigen::Matrix3d::Identity();
-  CHECK_FALSE(checkStandstill(wf, 1, I, 0.0, o).still);
+  CHECK_FALSE(check_standstill(wf, 1, I, 0.0, o).still);
   for (auto& [id, f] : wf.all())
     if (id >= 30) f.weight = 0.05;  // what the robust BA does to them
-  const StandstillCheck c = checkStandstill(wf, 1, I, 0.0, o);
+  const StandstillCheck c = check_standstill(wf, 1, I, 0.0, o);
   CHECK(c.still);
   CHECK(c.features == 30);
 }
 
-TEST_CASE("checkStandstill: speed, feature count and the switch guard the decision", "[standstill]") {
+TEST_CASE("check_standstill: speed, feature count and the switch guard the decision", "[standstill]") {
   StandstillOptions o;
   const Camera a, b;
-  const WindowFeatures wf = twoFrames(a, b, 60, 0, Eigen::Vector3d::Zero());
+  const WindowFeatures wf = two_frames(a, b, 60, 0, Eigen::Vector3d::Zero());
   const Eigen::Matrix3d I = Eigen::Matrix3d::Identity();
-  CHECK(checkStandstill(wf, 1, I, 0.05, o).still);
-  CHECK_FALSE(checkStandstill(wf, 1, I, 0.5, o).still);  // the last solve says it moves
-  const WindowFeatures few = twoFrames(a, b, o.min_features - 1, 0, Eigen::Vector3d::Zero());
-  CHECK_FALSE(checkStandstill(few, 1, I, 0.0, o).still);
-  CHECK_FALSE(checkStandstill(wf, 0, I, 0.0, o).still);  // no previous frame
+  CHECK(check_standstill(wf, 1, I, 0.05, o).still);
+  CHECK_FALSE(check_standstill(wf, 1, I, 0.5, o).still);  // the last solve says it moves
+  const WindowFeatures few = two_frames(a, b, o.min_features - 1, 0, Eigen::Vector3d::Zero());
+  CHECK_FALSE(check_standstill(few, 1, I, 0.0, o).still);
+  CHECK_FALSE(check_standstill(wf, 0, I, 0.0, o).still);  // no previous frame
   o.enabled = false;
-  const StandstillCheck off = checkStandstill(wf, 1, I, 0.0, o);
+  const StandstillCheck off = check_standstill(wf, 1, I, 0.0, o);
   CHECK_FALSE(off.still);
   CHECK(off.features == 60);  // still measured, for the log
 }

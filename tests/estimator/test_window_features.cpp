@@ -40,7 +40,7 @@ struct Scene {
   }
 };
 
-Scene makeScene(int n) {
+Scene make_scene(int n) {
   std::mt19937 rng(3);
   std::uniform_real_distribution<double> xy(-3, 3), z(4, 12);
   Scene s;
@@ -48,24 +48,24 @@ Scene makeScene(int n) {
   return s;
 }
 
-Eigen::Vector3d worldPoint(const WindowFeature& f, const CameraPose& anchor) {
+Eigen::Vector3d world_point(const WindowFeature& f, const CameraPose& anchor) {
   return anchor.R * (Eigen::Vector3d(f.obs[0].xy.x(), f.obs[0].xy.y(), 1.0) / f.inv_depth) + anchor.p;
 }
 
 }  // namespace
 
 TEST_CASE("two-view triangulation recovers the true point", "[window_features]") {
-  const Scene s = makeScene(20);
+  const Scene s = make_scene(20);
   for (const auto& p : s.points) {
     const CameraPose a = s.camera(0), b = s.camera(3);
     const Eigen::Vector3d pa = a.R.transpose() * (p - a.p), pb = b.R.transpose() * (p - b.p);
-    const Eigen::Vector3d x = triangulateTwoView(a, b, pa.head<2>() / pa.z(), pb.head<2>() / pb.z());
+    const Eigen::Vector3d x = triangulate_two_view(a, b, pa.head<2>() / pa.z(), pb.head<2>() / pb.z());
     CHECK((x - p).norm() < 1e-9);
   }
 }
 
 TEST_CASE("stereo depths, slot shifts and re-anchoring keep every feature on its world point", "[window_features]") {
-  const Scene s = makeScene(120);
+  const Scene s = make_scene(120);
   Eigen::Isometry3d T_c0c1 = Eigen::Isometry3d::Identity();
   T_c0c1.translation() = Eigen::Vector3d(0.11, 0, 0);
   WindowFeatures wf;
@@ -78,48 +78,48 @@ TEST_CASE("stereo depths, slot shifts and re-anchoring keep every feature on its
       const TrackedFrame extra = s.frame(k, 100, 20, T_c0c1);
       f.features.insert(f.features.end(), extra.features.begin(), extra.features.end());
     }
-    wf.addFrame(k, f, 10.0 / kNominalFocalPx, true);
+    wf.add_frame(k, f, 10.0 / kNominalFocalPx, true);
   }
   SlotCameraPose cam = [&](int k) { return cams[k]; };
   wf.triangulate(cam, T_c0c1, true);
   REQUIRE(wf.all().size() == 120);
   for (const auto& [id, f] : wf.all()) {
     REQUIRE(f.has_depth);
-    CHECK((worldPoint(f, cams[f.start_slot]) - s.points[id]).norm() < 1e-6);
-    CHECK(f.inBa() == (f.obs.size() >= 4));
+    CHECK((world_point(f, cams[f.start_slot]) - s.points[id]).norm() < 1e-6);
+    CHECK(f.in_ba() == (f.obs.size() >= 4));
   }
   CHECK(wf.all().at(0).start_slot == 0);
   CHECK(wf.all().at(100).start_slot == 2);
 
   // Drop the second newest (slot 3): slot 4 becomes 3; features keep their points.
-  wf.removeSlot(3, cam);
+  wf.remove_slot(3, cam);
   cams.erase(cams.begin() + 3);
   for (const auto& [id, f] : wf.all()) {
-    CHECK(f.endSlot() == 3);
-    CHECK((worldPoint(f, cams[f.start_slot]) - s.points[id]).norm() < 1e-6);
+    CHECK(f.end_slot() == 3);
+    CHECK((world_point(f, cams[f.start_slot]) - s.points[id]).norm() < 1e-6);
   }
   // Drop the oldest: features anchored at 0 move their anchor to the old slot 1 (now 0).
-  wf.removeOldest(cam);
+  wf.remove_oldest(cam);
   cams.erase(cams.begin());
   for (const auto& [id, f] : wf.all()) {
     CHECK(f.start_slot == (id < 100 ? 0 : 1));
-    CHECK((worldPoint(f, cams[f.start_slot]) - s.points[id]).norm() < 1e-6);
+    CHECK((world_point(f, cams[f.start_slot]) - s.points[id]).norm() < 1e-6);
   }
 }
 
 TEST_CASE("keyframe decision follows parallax and new features", "[window_features]") {
-  const Scene s = makeScene(100);
+  const Scene s = make_scene(100);
   const Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
   WindowFeatures wf;
-  CHECK(wf.addFrame(0, s.frame(0, 0, 100, T), 10.0 / kNominalFocalPx, false));  // early in the window
-  CHECK(wf.addFrame(1, s.frame(1, 0, 100, T), 10.0 / kNominalFocalPx, false));
+  CHECK(wf.add_frame(0, s.frame(0, 0, 100, T), 10.0 / kNominalFocalPx, false));  // early in the window
+  CHECK(wf.add_frame(1, s.frame(1, 0, 100, T), 10.0 / kNominalFocalPx, false));
   // 0.3 m steps at 4-12 m give tens of pixels of parallax: keyframe.
-  CHECK(wf.addFrame(2, s.frame(2, 0, 100, T), 10.0 / kNominalFocalPx, false));
-  CHECK(wf.lastTrackedCount() == 100);
+  CHECK(wf.add_frame(2, s.frame(2, 0, 100, T), 10.0 / kNominalFocalPx, false));
+  CHECK(wf.last_tracked_count() == 100);
   // An impossible parallax threshold, all tracked, long tracks: not a keyframe.
-  CHECK(wf.addFrame(3, s.frame(3, 0, 100, T), 1e3, false) == false);
+  CHECK(wf.add_frame(3, s.frame(3, 0, 100, T), 1e3, false) == false);
   // Most features new: keyframe whatever the parallax.
   WindowFeatures wf2;
-  for (int k = 0; k < 3; ++k) wf2.addFrame(k, s.frame(k, 0, 60, T), 1e3, false);
-  CHECK(wf2.addFrame(3, s.frame(3, 30, 70, T), 1e3, false));
+  for (int k = 0; k < 3; ++k) wf2.add_frame(k, s.frame(k, 0, 60, T), 1e3, false);
+  CHECK(wf2.add_frame(3, s.frame(3, 30, 70, T), 1e3, false));
 }

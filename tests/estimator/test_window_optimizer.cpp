@@ -45,12 +45,12 @@ struct SyntheticWindow {
   int newest() const { return kWindowSize; }
   bool moving(int64_t id) const { return moving_ids.count(id) > 0; }
   /// Largest position [m] and rotation [deg] error over the slots.
-  double maxPositionError() const {
+  double max_position_error() const {
     double e = 0;
     for (int k = 0; k <= newest(); ++k) e = std::max(e, (state.p(k) - p_true[k]).norm());
     return e;
   }
-  double maxRotationErrorDeg() const {
+  double max_rotation_error_deg() const {
     double e = 0;
     for (int k = 0; k <= newest(); ++k)
       e = std::max(e, Eigen::AngleAxisd(q_true[k].conjugate() * state.q(k)).angle() * 180.0 / M_PI);
@@ -69,7 +69,7 @@ SyntheticWindow::SyntheticWindow(const WindowSetup& setup) {
   test::ScenarioOptions so;
   so.landmarks = 0;  // the features are made here, with stereo and moving points
   so.gyro_bias.setZero();
-  scenario = test::makeScenario(so);
+  scenario = test::make_scenario(so);
   REQUIRE(scenario.frames() == kWindowSize + 1);
 
   const Eigen::Quaterniond q_bc(scenario.R_bc);
@@ -86,7 +86,7 @@ SyntheticWindow::SyntheticWindow(const WindowSetup& setup) {
     q_true.push_back(Eigen::Quaterniond(x.R_wb).normalized());
     state.t_ns[k] = static_cast<int64_t>(std::llround(scenario.t[k] * 1e9));
     state.v(k) = x.v_w;
-    if (k > 0) state.preint[k] = std::make_unique<ImuPreintegration>(*scenario.preints[k - 1]);
+    if (k > 0) state.preint[k] = std::make_unique<imu::ImuPreintegration>(*scenario.preints[k - 1]);
     Eigen::Vector3d dp = Eigen::Vector3d::Zero(), dtheta = Eigen::Vector3d::Zero();
     if (k > 0) {
       dp = setup.pose_offset_m / std::sqrt(3.0) * Eigen::Vector3d(n01(rng), n01(rng), n01(rng));
@@ -159,7 +159,7 @@ SyntheticWindow::SyntheticWindow(const WindowSetup& setup) {
   }
 }
 
-WindowSolveOptions solveOptions(BaLoss loss) {
+WindowSolveOptions solve_options(BaLoss loss) {
   WindowSolveOptions o;
   o.loss = loss;
   o.stereo = true;
@@ -173,8 +173,8 @@ WindowSolveOptions solveOptions(BaLoss loss) {
 TEST_CASE("dynavins BA keeps static features, rejects moving ones and stays on the true path",
           "[estimator][window_optimizer]") {
   SyntheticWindow w(WindowSetup{});
-  WindowOptimizer optimizer(solveOptions(BaLoss::Dynavins));
-  const double start_error = w.maxPositionError();
+  WindowOptimizer optimizer(solve_options(BaLoss::Dynavins));
+  const double start_error = w.max_position_error();
   const SolveStats st = optimizer.solve(w.state, w.newest(), w.features);
 
   CHECK(st.features_in_window == 52);
@@ -201,21 +201,21 @@ TEST_CASE("dynavins BA keeps static features, rejects moving ones and stays on t
     setup.moving_features = 0;  // same static observations and start (same seed, drawn first)
     return setup;
   }());
-  WindowOptimizer(solveOptions(BaLoss::Dynavins)).solve(static_only.state, static_only.newest(), static_only.features);
+  WindowOptimizer(solve_options(BaLoss::Dynavins)).solve(static_only.state, static_only.newest(), static_only.features);
   double from_static_only = 0;
   for (int k = 0; k <= w.newest(); ++k)
     from_static_only = std::max(from_static_only, (w.state.p(k) - static_only.state.p(k)).norm());
-  INFO("start error " << start_error << " m; solved " << w.maxPositionError() << " m, " << w.maxRotationErrorDeg()
+  INFO("start error " << start_error << " m; solved " << w.max_position_error() << " m, " << w.max_rotation_error_deg()
                       << " deg, " << from_static_only << " m from the solve without moving points; static weights >= "
                       << min_static << ", moving <= " << max_moving);
-  CHECK(w.maxPositionError() < 0.01);
-  CHECK(w.maxRotationErrorDeg() < 0.15);
+  CHECK(w.max_position_error() < 0.01);
+  CHECK(w.max_rotation_error_deg() < 0.15);
   CHECK(from_static_only < 0.002);
 }
 
 TEST_CASE("huber BA leaves every weight at 1", "[estimator][window_optimizer]") {
   SyntheticWindow w(WindowSetup{});
-  WindowOptimizer optimizer(solveOptions(BaLoss::Huber));
+  WindowOptimizer optimizer(solve_options(BaLoss::Huber));
   const SolveStats st = optimizer.solve(w.state, w.newest(), w.features);
   CHECK(st.alternations == 1);
   CHECK(st.features_in_window == 52);
@@ -226,8 +226,8 @@ TEST_CASE("huber BA leaves every weight at 1", "[estimator][window_optimizer]") 
     CHECK(f.times_solved == 0);
   }
   // Unweighted, the moving points do pull the solve off the path (0.26 m): the scene tests something.
-  INFO("solved " << w.maxPositionError() << " m, " << w.maxRotationErrorDeg() << " deg");
-  CHECK(w.maxPositionError() > 0.05);
+  INFO("solved " << w.max_position_error() << " m, " << w.max_rotation_error_deg() << " deg");
+  CHECK(w.max_position_error() > 0.05);
 }
 
 TEST_CASE("momentum (eq. 9-10): a feature's weight moves more slowly the more often it was solved",
@@ -237,7 +237,7 @@ TEST_CASE("momentum (eq. 9-10): a feature's weight moves more slowly the more of
   // about (λw + 25 λm) / λw = 6 times higher); with λm = 0 n_j does not matter at all.
   for (const double lambda_m : {0.2, 0.0}) {
     INFO("lambda_m " << lambda_m);
-    WindowSolveOptions o = solveOptions(BaLoss::Dynavins);
+    WindowSolveOptions o = solve_options(BaLoss::Dynavins);
     o.weights.lambda_m = lambda_m;
     WindowSetup seasoned_setup;
     seasoned_setup.times_solved = 5;
@@ -289,12 +289,12 @@ TEST_CASE("a feature the robust BA rejected (weight < margin_feature_thresh) sta
     } else {
       features.all().at(leaving).weight = weight;
     }
-    WindowOptimizer optimizer(solveOptions(loss));
-    optimizer.marginalizeOldest(w.state, w.newest(), features);
-    REQUIRE(optimizer.hasPrior());
+    WindowOptimizer optimizer(solve_options(loss));
+    optimizer.marginalize_oldest(w.state, w.newest(), features);
+    REQUIRE(optimizer.has_prior());
     const MarginalizationInfo& info = *optimizer.prior();
-    const Eigen::MatrixXd& J = info.linearizedJacobian();
-    return Prior{info.keptBlocks(), J.transpose() * J, J.transpose() * info.linearizedResidual()};
+    const Eigen::MatrixXd& J = info.linearized_jacobian();
+    return Prior{info.kept_blocks(), J.transpose() * J, J.transpose() * info.linearized_residual()};
   };
   auto relativeDifference = [](const Prior& a, const Prior& b) {
     REQUIRE(a.blocks == b.blocks);

@@ -18,7 +18,7 @@ TEST_CASE("ZeroVelocityFactor: residual is the whitened velocity, biases do not 
   const Evaluation e = evaluate(f, {sb});
   CHECK(e.residual.isApprox(Eigen::Vector3d(5.0, -10.0, 2.0)));
   CHECK(e.jacobians[0].rightCols(6).cwiseAbs().maxCoeff() == 0.0);
-  requireJacobiansMatchNumeric(f, {sb}, {Block::Euclidean});
+  require_jacobians_match_numeric(f, {sb}, {Block::Euclidean});
   CHECK_THROWS_AS(ZeroVelocityFactor(0.0), std::invalid_argument);
 }
 

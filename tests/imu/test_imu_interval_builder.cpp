@@ -16,20 +16,20 @@ namespace so3 = dynavins::so3;
 
 namespace {
 
-std::vector<ImuSample> imu(const SmoothTrajectory& tr, int64_t t0, int64_t t1) {
+std::vector<ImuSample> imu_samples(const SmoothTrajectory& tr, int64_t t0, int64_t t1) {
   ImuSimulatorOptions o;
-  o.noise = ImuNoiseModel::noiseFree();
+  o.noise = ImuNoiseModel::noise_free();
   return ImuSimulator(o).simulate(tr, t0, t1).samples;
 }
 
 // 20 Hz frames off the 200 Hz IMU grid (offset 1.2345 ms).
-std::vector<int64_t> frameTimes() {
+std::vector<int64_t> frame_times() {
   std::vector<int64_t> f;
   for (int k = 0; k < 10; ++k) f.push_back(2'001'234'500 + k * 50'000'000LL);
   return f;
 }
 
-double maxDeltaError(const SmoothTrajectory& tr, const PreintegratedInterval& iv) {
+double max_delta_error(const SmoothTrajectory& tr, const PreintegratedInterval& iv) {
   const KinematicState a = tr.evaluate(iv.t_begin_ns * 1e-9), b = tr.evaluate(iv.t_end_ns * 1e-9);
   const double T = (iv.t_end_ns - iv.t_begin_ns) * 1e-9;
   const Eigen::Vector3d g(0, 0, -9.81);
@@ -44,14 +44,14 @@ double maxDeltaError(const SmoothTrajectory& tr, const PreintegratedInterval& iv
 
 TEST_CASE("one interval per consecutive frame pair, ends at the frame times, matching ground truth",
           "[imu][interval_builder]") {
-  const SmoothTrajectory tr = wavyTrajectory(6.0);
-  const std::vector<ImuSample> s = imu(tr, 1'900'000'000, 2'600'000'000);
-  const std::vector<int64_t> f = frameTimes();
-  ImuIntervalBuilder b;
+  const SmoothTrajectory tr = wavy_trajectory(6.0);
+  const std::vector<ImuSample> s = imu_samples(tr, 1'900'000'000, 2'600'000'000);
+  const std::vector<int64_t> f = frame_times();
+  imu::ImuIntervalBuilder b;
   std::vector<PreintegratedInterval> out;
-  for (int64_t t : f) b.addFrame(t);  // frames first: nothing can be emitted yet
+  for (int64_t t : f) b.add_frame(t);  // frames first: nothing can be emitted yet
   for (const ImuSample& x : s)
-    for (auto& iv : b.addImu(x)) out.push_back(std::move(iv));
+    for (auto& iv : b.add_imu(x)) out.push_back(std::move(iv));
   REQUIRE(out.size() == f.size() - 1);
   double worst = 0.0;
   for (size_t k = 0; k < out.size(); ++k) {
@@ -63,7 +63,7 @@ TEST_CASE("one interval per consecutive frame pair, ends at the frame times, mat
     CHECK(out[k].num_raw_samples == 10);
     CHECK_FALSE(out[k].has_gap);
     CHECK(out[k].max_gap_ns == 5'000'000);
-    worst = std::max(worst, maxDeltaError(tr, out[k]));
+    worst = std::max(worst, max_delta_error(tr, out[k]));
   }
   // Linear interpolation of the end samples adds O(dt^2 * jerk) to the midpoint error; still far below noise.
   INFO("worst delta error vs truth " << worst);
@@ -72,22 +72,22 @@ TEST_CASE("one interval per consecutive frame pair, ends at the frame times, mat
 }
 
 TEST_CASE("the interleaving of IMU and frames does not change the intervals", "[imu][interval_builder]") {
-  const SmoothTrajectory tr = wavyTrajectory(6.0);
-  const std::vector<ImuSample> s = imu(tr, 1'900'000'000, 2'600'000'000);
-  const std::vector<int64_t> f = frameTimes();
+  const SmoothTrajectory tr = wavy_trajectory(6.0);
+  const std::vector<ImuSample> s = imu_samples(tr, 1'900'000'000, 2'600'000'000);
+  const std::vector<int64_t> f = frame_times();
   // Reference: all IMU first, then the frames.
-  ImuIntervalBuilder ref;
+  imu::ImuIntervalBuilder ref;
   std::vector<PreintegratedInterval> a, c;
-  for (const ImuSample& x : s) ref.addImu(x);
+  for (const ImuSample& x : s) ref.add_imu(x);
   for (int64_t t : f)
-    for (auto& iv : ref.addFrame(t)) a.push_back(std::move(iv));
+    for (auto& iv : ref.add_frame(t)) a.push_back(std::move(iv));
   // Live-like: each frame arrives 3 IMU samples after its time.
-  ImuIntervalBuilder live;
+  imu::ImuIntervalBuilder live;
   size_t fi = 0;
   for (const ImuSample& x : s) {
-    for (auto& iv : live.addImu(x)) c.push_back(std::move(iv));
+    for (auto& iv : live.add_imu(x)) c.push_back(std::move(iv));
     while (fi < f.size() && f[fi] + 15'000'000 <= x.t_ns)
-      for (auto& iv : live.addFrame(f[fi++])) c.push_back(std::move(iv));
+      for (auto& iv : live.add_frame(f[fi++])) c.push_back(std::move(iv));
   }
   REQUIRE(a.size() == f.size() - 1);
   REQUIRE(c.size() == a.size());
@@ -99,24 +99,24 @@ TEST_CASE("the interleaving of IMU and frames does not change the intervals", "[
 }
 
 TEST_CASE("out-of-order and duplicate IMU samples are rejected and counted", "[imu][interval_builder]") {
-  const SmoothTrajectory tr = wavyTrajectory(6.0);
-  const std::vector<ImuSample> s = imu(tr, 1'900'000'000, 2'600'000'000);
-  const std::vector<int64_t> f = frameTimes();
-  ImuIntervalBuilder clean, dirty;
+  const SmoothTrajectory tr = wavy_trajectory(6.0);
+  const std::vector<ImuSample> s = imu_samples(tr, 1'900'000'000, 2'600'000'000);
+  const std::vector<int64_t> f = frame_times();
+  imu::ImuIntervalBuilder clean, dirty;
   std::vector<PreintegratedInterval> a, c;
   for (int64_t t : f) {
-    clean.addFrame(t);
-    dirty.addFrame(t);
+    clean.add_frame(t);
+    dirty.add_frame(t);
   }
   for (size_t k = 0; k < s.size(); ++k) {
-    for (auto& iv : clean.addImu(s[k])) a.push_back(std::move(iv));
-    for (auto& iv : dirty.addImu(s[k])) c.push_back(std::move(iv));
+    for (auto& iv : clean.add_imu(s[k])) a.push_back(std::move(iv));
+    for (auto& iv : dirty.add_imu(s[k])) c.push_back(std::move(iv));
     if (k == 30) {
-      dirty.addImu(s[k]);      // duplicate
-      dirty.addImu(s[k - 5]);  // late
+      dirty.add_imu(s[k]);      // duplicate
+      dirty.add_imu(s[k - 5]);  // late
       ImuSample odd = s[k];
       odd.t_ns -= 1;           // 1 ns before the last accepted one
-      dirty.addImu(odd);
+      dirty.add_imu(odd);
     }
   }
   CHECK(dirty.stats().imu_rejected_out_of_order == 3);
@@ -124,24 +124,24 @@ TEST_CASE("out-of-order and duplicate IMU samples are rejected and counted", "[i
   REQUIRE(a.size() == c.size());
   for (size_t k = 0; k < a.size(); ++k) CHECK((a[k].preint.beta - c[k].preint.beta).norm() == 0.0);
   // Frames going backwards are rejected too.
-  dirty.addFrame(f[3]);
+  dirty.add_frame(f[3]);
   CHECK(dirty.stats().frames_rejected_out_of_order == 1);
 }
 
 TEST_CASE("an IMU gap above 3 periods is reported in its interval, not bridged silently",
           "[imu][interval_builder]") {
-  const SmoothTrajectory tr = wavyTrajectory(6.0);
-  const std::vector<ImuSample> s = imu(tr, 1'900'000'000, 2'600'000'000);
-  const std::vector<int64_t> f = frameTimes();
-  ImuIntervalBuilder b;
-  CHECK(b.gapThresholdNs() == 15'000'000);
-  for (int64_t t : f) b.addFrame(t);
+  const SmoothTrajectory tr = wavy_trajectory(6.0);
+  const std::vector<ImuSample> s = imu_samples(tr, 1'900'000'000, 2'600'000'000);
+  const std::vector<int64_t> f = frame_times();
+  imu::ImuIntervalBuilder b;
+  CHECK(b.gap_threshold_ns() == 15'000'000);
+  for (int64_t t : f) b.add_frame(t);
   std::vector<PreintegratedInterval> out;
   for (const ImuSample& x : s) {
     // Drop 5 samples inside interval 2 ((2.1012, 2.1512] s): a 30 ms hole; drop 2 inside interval 5 (15 ms).
     if (x.t_ns > 2'110'000'000 && x.t_ns <= 2'135'000'000) continue;
     if (x.t_ns > 2'260'000'000 && x.t_ns <= 2'270'000'000) continue;
-    for (auto& iv : b.addImu(x)) out.push_back(std::move(iv));
+    for (auto& iv : b.add_imu(x)) out.push_back(std::move(iv));
   }
   REQUIRE(out.size() == f.size() - 1);
   for (size_t k = 0; k < out.size(); ++k) {
@@ -154,14 +154,14 @@ TEST_CASE("an IMU gap above 3 periods is reported in its interval, not bridged s
 }
 
 TEST_CASE("a frame with no IMU before it starts no interval and is counted", "[imu][interval_builder]") {
-  const SmoothTrajectory tr = wavyTrajectory(6.0);
-  const std::vector<ImuSample> s = imu(tr, 2'030'000'000, 2'600'000'000);  // starts after the first frame
-  const std::vector<int64_t> f = frameTimes();
-  ImuIntervalBuilder b;
+  const SmoothTrajectory tr = wavy_trajectory(6.0);
+  const std::vector<ImuSample> s = imu_samples(tr, 2'030'000'000, 2'600'000'000);  // starts after the first frame
+  const std::vector<int64_t> f = frame_times();
+  imu::ImuIntervalBuilder b;
   std::vector<PreintegratedInterval> out;
-  for (int64_t t : f) b.addFrame(t);
+  for (int64_t t : f) b.add_frame(t);
   for (const ImuSample& x : s)
-    for (auto& iv : b.addImu(x)) out.push_back(std::move(iv));
+    for (auto& iv : b.add_imu(x)) out.push_back(std::move(iv));
   CHECK(b.stats().frames_without_imu_before == 1);
   REQUIRE(out.size() == f.size() - 2);
   CHECK(out.front().t_begin_ns == f[1]);

@@ -8,7 +8,7 @@
 
 namespace dynavins::sim {
 
-inline SmoothTrajectory wavyTrajectory(double duration = 8.0) {
+inline SmoothTrajectory wavy_trajectory(double duration = 8.0) {
   std::vector<Waypoint> w;
   for (int k = 0; 0.5 * k <= duration; ++k) {
     const double t = 0.5 * k;
@@ -20,7 +20,7 @@ inline SmoothTrajectory wavyTrajectory(double duration = 8.0) {
     p.roll = 0.25 * std::cos(0.9 * t);
     w.push_back(p);
   }
-  return trajectoryFromTimedWaypoints(w);
+  return trajectory_from_timed_waypoints(w);
 }
 
 }  // namespace dynavins::sim

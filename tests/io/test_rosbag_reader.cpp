@@ -39,7 +39,7 @@ namespace {
 constexpr int64_t kMs = 1'000'000;
 constexpr int64_t kUs = 1'000;
 constexpr int64_t kT0 = 1'600'000'000LL * 1'000'000'000LL;  // a plausible wall-clock stamp
-constexpr int kW = 8;
+constexpr int kWorld = 8;
 constexpr int kH = 6;
 
 // A fresh directory per test case, removed afterwards.
@@ -69,9 +69,9 @@ ros::Time ros_time(int64_t ns) {
 uint8_t pixel(int seed, int r, int c) { return static_cast<uint8_t>(seed * 37 + r * 11 + c * 3); }
 
 cv::Mat expected_gray(int seed) {
-  cv::Mat m(kH, kW, CV_8UC1);
+  cv::Mat m(kH, kWorld, CV_8UC1);
   for (int r = 0; r < kH; ++r)
-    for (int c = 0; c < kW; ++c) m.at<uint8_t>(r, c) = pixel(seed, r, c);
+    for (int c = 0; c < kWorld; ++c) m.at<uint8_t>(r, c) = pixel(seed, r, c);
   return m;
 }
 
@@ -81,12 +81,12 @@ sensor_msgs::Image mono_image(int64_t t_ns, int seed, int pad = 0) {
   img.header.stamp = ros_time(t_ns);
   img.header.frame_id = "cam";
   img.height = kH;
-  img.width = kW;
+  img.width = kWorld;
   img.encoding = "mono8";
-  img.step = kW + pad;
+  img.step = kWorld + pad;
   img.data.assign(img.step * kH, 0xEE);
   for (int r = 0; r < kH; ++r)
-    for (int c = 0; c < kW; ++c) img.data[r * img.step + c] = pixel(seed, r, c);
+    for (int c = 0; c < kWorld; ++c) img.data[r * img.step + c] = pixel(seed, r, c);
   return img;
 }
 
@@ -211,12 +211,12 @@ sensor_msgs::Image colour_image(const std::string& encoding) {
   const int ch = (encoding == "bgra8" || encoding == "rgba8") ? 4 : 3;
   sensor_msgs::Image img;
   img.height = kH;
-  img.width = kW;
+  img.width = kWorld;
   img.encoding = encoding;
-  img.step = kW * ch;
+  img.step = kWorld * ch;
   img.data.resize(img.step * kH);
   for (int r = 0; r < kH; ++r)
-    for (int c = 0; c < kW; ++c)
+    for (int c = 0; c < kWorld; ++c)
       for (int k = 0; k < ch; ++k)
         img.data[r * img.step + c * ch + k] = static_cast<uint8_t>(20 + 30 * k + 17 * r + 9 * c);
   return img;
@@ -519,11 +519,11 @@ TEST_CASE("RosbagReader converts colour encodings to gray", "[rosbag]") {
     INFO(encodings[j]);
     const cv::Mat& g = frames[j].left;
     REQUIRE(g.type() == CV_8UC1);
-    REQUIRE(g.size() == cv::Size(kW, kH));
+    REQUIRE(g.size() == cv::Size(kWorld, kH));
     const bool bgr = encodings[j][0] == 'b';
     const int ch = encodings[j].size() == 5 ? 4 : 3;
     for (int r = 0; r < kH; ++r)
-      for (int c = 0; c < kW; ++c) {
+      for (int c = 0; c < kWorld; ++c) {
         const uint8_t* px = &left[j].data[r * left[j].step + c * ch];
         const double b = bgr ? px[0] : px[2], gr = px[1], rd = bgr ? px[2] : px[0];
         // ITU-R BT.601 luma, as OpenCV's cvtColor computes it (fixed point: within 1).
@@ -564,7 +564,7 @@ TEST_CASE("RosbagReader rejects bad images naming the topic and message", "[rosb
                       Contains(path) && Contains("/cam0/image_raw") && Contains("message #1") && Contains("47 bytes"));
   }
   SECTION("step shorter than a row") {
-    left[0].step = kW - 1;
+    left[0].step = kWorld - 1;
     left[0].data.resize(left[0].step * kH);
     write_image_bag(path, left);
     RosbagReader reader(path);

@@ -54,7 +54,7 @@ struct Recorder {
   }
 };
 
-PublisherChannels testChannels() {
+PublisherChannels test_channels() {
   PublisherChannels c;
   for (const char* a : {"pose_imu=P_IMU", "pose=P", "features=F", "status=S", "stats=ST"}) c.set(a);
   return c;
@@ -76,7 +76,7 @@ TEST_CASE("LcmPublisher: each item reaches its channel, decoded as sent", "[lcm_
   REQUIRE(lcm.good());
   Recorder rx;
   lcm.subscribe(".*", &Recorder::on, &rx);
-  LcmPublisher pub(lcm, testChannels());
+  LcmPublisher pub(lcm, test_channels());
 
   NavState s;
   s.t_ns = 1'000'000'000;
@@ -115,7 +115,7 @@ TEST_CASE("LcmPublisher: a status change goes out at once, a repeat does not", "
   lcm::LCM lcm("memq://");
   Recorder rx;
   lcm.subscribe(".*", &Recorder::on, &rx);
-  LcmPublisher pub(lcm, testChannels(), [] { return RunReport{}; });
+  LcmPublisher pub(lcm, test_channels(), [] { return RunReport{}; });
   using estimator::EstimatorStatus;
   pub.process(PublishItem{0, status(1, EstimatorStatus::Initializing)});
   pub.process(PublishItem{0, status(2, EstimatorStatus::Initializing)});  // no change: not sent yet
@@ -153,7 +153,7 @@ TEST_CASE("LcmPublisher: loop outputs (corrected pose, path, hypotheses) reach t
   lcm::LCM lcm("memq://");
   Recorder rx;
   lcm.subscribe(".*", &Recorder::on, &rx);
-  PublisherChannels c = testChannels();
+  PublisherChannels c = test_channels();
   c.set("pose_corrected=PC");
   c.set("path=PATH");
   c.set("loops=LOOPS");

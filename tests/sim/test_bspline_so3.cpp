@@ -13,7 +13,7 @@ namespace so3 = dynavins::so3;
 namespace {
 
 // Random control rotations whose consecutive increments are up to `step` rad (a lively motion).
-std::vector<Eigen::Matrix3d> randomControl(int n, double step, uint64_t seed) {
+std::vector<Eigen::Matrix3d> random_control(int n, double step, uint64_t seed) {
   std::mt19937_64 rng(seed);
   std::uniform_real_distribution<double> u(-1.0, 1.0);
   std::vector<Eigen::Matrix3d> c{so3::exp(Eigen::Vector3d(u(rng), u(rng), u(rng)) * 2.0)};
@@ -32,21 +32,21 @@ TEST_CASE("so3 Exp/Log round trip and Jacobian identities", "[sim][so3]") {
     CHECK((R.transpose() * R - Eigen::Matrix3d::Identity()).norm() < 1e-14);
     CHECK((so3::log(R) - phi).norm() < 1e-12 * std::max(1.0, scale));
     CHECK((R - Eigen::Matrix3d(Eigen::AngleAxisd(scale, phi.normalized()))).norm() < 1e-14);
-    CHECK((so3::rightJacobian(phi) * so3::rightJacobianInverse(phi) - Eigen::Matrix3d::Identity()).norm() < 1e-12);
+    CHECK((so3::right_jacobian(phi) * so3::right_jacobian_inverse(phi) - Eigen::Matrix3d::Identity()).norm() < 1e-12);
     // Exp(φ + δ) ≈ Exp(φ) Exp(Jr(φ) δ): the error is second order in δ.
     const Eigen::Vector3d d(1e-6, -2e-6, 1.5e-6);
-    CHECK(so3::log((R * so3::exp(so3::rightJacobian(phi) * d)).transpose() * so3::exp(phi + d)).norm() < 1e-11);
+    CHECK(so3::log((R * so3::exp(so3::right_jacobian(phi) * d)).transpose() * so3::exp(phi + d)).norm() < 1e-11);
     // Log(Exp(δ) R) ≈ φ + Jl^-1(φ) δ (first order; skip the near-pi case where Log itself is ill-conditioned)
-    if (scale < 3.0) CHECK((so3::log(so3::exp(d) * R) - phi - so3::leftJacobianInverse(phi) * d).norm() < 1e-11);
+    if (scale < 3.0) CHECK((so3::log(so3::exp(d) * R) - phi - so3::left_jacobian_inverse(phi) * d).norm() < 1e-11);
   }
 }
 
 TEST_CASE("SO(3) spline body rates match numeric differentiation", "[sim][bspline_so3]") {
   const double dt = 0.1;
-  const BSplineSO3 s(2.0, dt, randomControl(14, 0.3, 11));
+  const BSplineSO3 s(2.0, dt, random_control(14, 0.3, 11));
   const double h = 1e-5;
   double max_w_err = 0.0, max_a_err = 0.0, max_w = 0.0;
-  for (double t = s.knots().tMin() + 2 * h; t < s.knots().tMax() - 2 * h; t += 0.0137) {
+  for (double t = s.knots().t_min() + 2 * h; t < s.knots().t_max() - 2 * h; t += 0.0137) {
     const SplineSO3Value v = s.evaluate(t);
     CHECK((v.R.transpose() * v.R - Eigen::Matrix3d::Identity()).norm() < 1e-12);
     // ω from the central difference of R: Log(R(t-h)^T R(t+h)) / 2h, error O(h^2).
@@ -65,8 +65,8 @@ TEST_CASE("SO(3) spline body rates match numeric differentiation", "[sim][bsplin
 
 TEST_CASE("SO(3) spline is C2 across knots", "[sim][bspline_so3]") {
   const double dt = 0.05;
-  const BSplineSO3 s(0.0, dt, randomControl(10, 0.2, 3));
-  for (int k = 1; k < s.knots().numSegments(); ++k) {
+  const BSplineSO3 s(0.0, dt, random_control(10, 0.2, 3));
+  for (int k = 1; k < s.knots().num_segments(); ++k) {
     const double tk = k * dt, e = 1e-9;
     const SplineSO3Value a = s.evaluate(tk - e), b = s.evaluate(tk + e);
     CHECK(so3::log(a.R.transpose() * b.R).norm() < 1e-7);
@@ -84,7 +84,7 @@ TEST_CASE("SO(3) spline reduces to a scalar B-spline about a fixed axis", "[sim]
   for (double a : ang) c.push_back(so3::exp(a * axis));
   const double dt = 0.2;
   const BSplineSO3 s(0.0, dt, c);
-  for (double t = 0.0; t <= s.knots().tMax(); t += 0.01) {
+  for (double t = 0.0; t <= s.knots().t_max(); t += 0.01) {
     const int i = std::min(static_cast<int>(t / dt), 2);
     const double u = t / dt - i;
     const double b[4] = {std::pow(1 - u, 3) / 6, (3 * u * u * u - 6 * u * u + 4) / 6,
@@ -103,13 +103,13 @@ TEST_CASE("SO(3) spline reduces to a scalar B-spline about a fixed axis", "[sim]
 
 TEST_CASE("SO(3) spline Jacobians w.r.t. control points match numeric perturbation", "[sim][bspline_so3]") {
   const double dt = 0.1;
-  const std::vector<Eigen::Matrix3d> c = randomControl(8, 0.5, 5);
+  const std::vector<Eigen::Matrix3d> c = random_control(8, 0.5, 5);
   const BSplineSO3 s(0.0, dt, c);
   const double eps = 1e-6;
   for (double t : {0.0, 0.031, 0.15, 0.2999, 0.37, 0.5}) {
     int first;
     std::array<Eigen::Matrix3d, 4> J;
-    const Eigen::Matrix3d R = s.orientationWithJacobians(t, first, J);
+    const Eigen::Matrix3d R = s.orientation_with_jacobians(t, first, J);
     CHECK(so3::log(R.transpose() * s.evaluate(t).R).norm() < 1e-14);
     for (int k = 0; k < 4; ++k)
       for (int ax = 0; ax < 3; ++ax) {

@@ -37,7 +37,7 @@ struct State {
 
 // Classical RK4 on (q, p, v) with q' = q (0, ω/2), p' = v, v' = R a + g. A step spans two IMU samples so
 // that the half-step stages use the middle sample (no interpolation error).
-State integrateRk4(const State& x0, const std::vector<ImuSample>& imu, size_t first, size_t steps, double g) {
+State integrate_rk4(const State& x0, const std::vector<ImuSample>& imu, size_t first, size_t steps, double g) {
   const Eigen::Vector3d gw(0, 0, -g);
   struct D {
     Eigen::Vector4d dq;
@@ -83,7 +83,7 @@ struct Drift {
 // at every step.
 Drift drift10s(const SmoothTrajectory& tr, double t0, double g = 9.81, double gyro_scale = 1.0) {
   ImuSimulatorOptions o;
-  o.noise = ImuNoiseModel::noiseFree();
+  o.noise = ImuNoiseModel::noise_free();
   o.gravity = g;
   const ImuSimulator sim(o);
   const auto t0_ns = static_cast<int64_t>(std::llround(t0 * 1e9));
@@ -94,7 +94,7 @@ Drift drift10s(const SmoothTrajectory& tr, double t0, double g = 9.81, double gy
   State x{g0.q_wb, g0.p_wb, g0.v_wb};
   Drift d;
   for (size_t k = 0; k + 2 < s.samples.size(); k += 2) {
-    x = integrateRk4(x, s.samples, k, 1, g);
+    x = integrate_rk4(x, s.samples, k, 1, g);
     const GroundTruthState& gt = s.truth[k + 2];
     d.pos = std::max(d.pos, (x.p - gt.p_wb).norm());
     d.vel = std::max(d.vel, (x.v - gt.v_wb).norm());
@@ -103,7 +103,7 @@ Drift drift10s(const SmoothTrajectory& tr, double t0, double g = 9.81, double gy
   return d;
 }
 
-double pathLength(const SmoothTrajectory& tr, double t0, double t1) {
+double path_length(const SmoothTrajectory& tr, double t0, double t1) {
   double L = 0;
   for (double t = t0; t < t1; t += 0.01) L += tr.velocity(t).norm() * 0.01;
   return L;
@@ -113,7 +113,7 @@ double pathLength(const SmoothTrajectory& tr, double t0, double t1) {
 
 TEST_CASE("Noise-free IMU integrates back to the scripted trajectory (< 1 cm in 10 s)", "[sim][imu_simulator]") {
   // Hand-held E walk, a 10 s stretch with a rounded corner, a stop and a turn in place.
-  const SmoothTrajectory tr = trajectoryFromPath(
+  const SmoothTrajectory tr = trajectory_from_path(
       {wp(0, 0, 0), wp(0, 5, 0),
        wp(3, 5, 0.5), wp(0, 5, 0),
        wp(0, 10, 0)},
@@ -121,7 +121,7 @@ TEST_CASE("Noise-free IMU integrates back to the scripted trajectory (< 1 cm in 
   REQUIRE(tr.duration() > 16.0);
   for (double t0 : {0.0, 3.0, 6.0}) {
     const Drift d = drift10s(tr, t0);
-    INFO("scripted, start " << t0 << " s, path " << pathLength(tr, t0, t0 + 10) << " m: max drift pos " << d.pos
+    INFO("scripted, start " << t0 << " s, path " << path_length(tr, t0, t0 + 10) << " m: max drift pos " << d.pos
                             << " m, vel " << d.vel << " m/s, rot " << d.rot << " rad");
     CHECK(d.pos < 0.01);
     CHECK(d.rot < 1e-4);
@@ -133,12 +133,12 @@ TEST_CASE("Noise-free IMU integrates back to a real EuRoC trajectory (< 1 cm in 
   TumFitOptions o;
   o.window_start = 20.0;
   o.window_duration = 31.0;
-  const SmoothTrajectory tr = fitTumTrajectory(std::string(DYNAVINS_SHARED_DIR) + "/data/trajectories/euroc_tum/V1_03_difficult.txt.gz", o);
+  const SmoothTrajectory tr = fit_tum_trajectory(std::string(DYNAVINS_SHARED_DIR) + "/data/trajectories/euroc_tum/V1_03_difficult.txt.gz", o);
   for (double t0 : {0.0, 10.0, 20.0}) {
     const Drift d = drift10s(tr, t0);
     double wmax = 0;
-    for (double t = t0; t < t0 + 10; t += 0.005) wmax = std::max(wmax, tr.angularVelocity(t).norm());
-    INFO("V1_03 from " << 20 + t0 << " s, path " << pathLength(tr, t0, t0 + 10) << " m, max |ω| " << wmax
+    for (double t = t0; t < t0 + 10; t += 0.005) wmax = std::max(wmax, tr.angular_velocity(t).norm());
+    INFO("V1_03 from " << 20 + t0 << " s, path " << path_length(tr, t0, t0 + 10) << " m, max |ω| " << wmax
                        << " rad/s: max drift pos " << d.pos << " m, vel " << d.vel << " m/s, rot " << d.rot << " rad");
     CHECK(d.pos < 0.01);
     CHECK(d.rot < 1e-4);
@@ -148,16 +148,16 @@ TEST_CASE("Noise-free IMU integrates back to a real EuRoC trajectory (< 1 cm in 
 TEST_CASE("The integration check detects an inconsistent IMU", "[sim][imu_simulator]") {
   // Negative controls for the two tests above: a 1 % gyro scale error or gravity off by 0.01 % (9.811
   // instead of 9.81) must each break the 1 cm bound.
-  const SmoothTrajectory tr = trajectoryFromPath({wp(0, 0, 0), wp(4, 0, 0), wp(4, 4, 0)}, PathProfile::handheld());
+  const SmoothTrajectory tr = trajectory_from_path({wp(0, 0, 0), wp(4, 0, 0), wp(4, 4, 0)}, PathProfile::handheld());
   const Drift scaled = drift10s(tr, 0.0, 9.81, 1.01);
   INFO("gyro scale 1.01: drift " << scaled.pos << " m");
   CHECK(scaled.pos > 0.01);
   ImuSimulatorOptions o;
-  o.noise = ImuNoiseModel::noiseFree();
+  o.noise = ImuNoiseModel::noise_free();
   o.gravity = 9.811;
   const ImuSimulation s = ImuSimulator(o).simulate(tr, 0, 10'000'000'000LL);
   const GroundTruthState& g0 = s.truth.front();
-  const State x = integrateRk4({g0.q_wb, g0.p_wb, g0.v_wb}, s.samples, 0, 1000, 9.81);
+  const State x = integrate_rk4({g0.q_wb, g0.p_wb, g0.v_wb}, s.samples, 0, 1000, 9.81);
   INFO("gravity 9.811 vs 9.81: drift " << (x.p - s.truth.back().p_wb).norm() << " m");
   CHECK((x.p - s.truth.back().p_wb).norm() > 0.01);
   // (A 5 ms timestamp offset moves this gentle path by only ~0.5 mm over 10 s, so timing is checked
@@ -165,10 +165,10 @@ TEST_CASE("The integration check detects an inconsistent IMU", "[sim][imu_simula
 }
 
 TEST_CASE("IMU at rest measures gravity in the body frame", "[sim][imu_simulator]") {
-  const Eigen::Matrix3d R = so3::fromYawPitchRoll(0.7, 0.3, -0.2);
+  const Eigen::Matrix3d R = so3::from_yaw_pitch_roll(0.7, 0.3, -0.2);
   const SmoothTrajectory tr = still(2.0, R);
   ImuSimulatorOptions o;
-  o.noise = ImuNoiseModel::noiseFree();
+  o.noise = ImuNoiseModel::noise_free();
   const ImuSimulator sim(o);
   const ImuSimulation s = sim.simulate(tr);
   REQUIRE(s.samples.size() == 401);  // 0 .. 2 s inclusive at 200 Hz
@@ -177,26 +177,26 @@ TEST_CASE("IMU at rest measures gravity in the body frame", "[sim][imu_simulator
     CHECK((m.acc - R.transpose() * Eigen::Vector3d(0, 0, 9.81)).norm() < 1e-12);
     CHECK(m.gyr.norm() < 1e-12);
   }
-  const ImuSample level = sim.idealSample(still(1.0), 0.5);
+  const ImuSample level = sim.ideal_sample(still(1.0), 0.5);
   CHECK((level.acc - Eigen::Vector3d(0, 0, 9.81)).norm() < 1e-12);
 }
 
 TEST_CASE("IMU timestamps and ground truth line up", "[sim][imu_simulator]") {
-  const SmoothTrajectory tr = trajectoryFromPath({wp(0, 0, 0), wp(3, 1, 0)},
+  const SmoothTrajectory tr = trajectory_from_path({wp(0, 0, 0), wp(3, 1, 0)},
                                                  PathProfile::drone())
-                                  .shiftedInTime(0.0123);
+                                  .shifted_in_time(0.0123);
   ImuSimulatorOptions o;
   o.rate_hz = 400.0;
   const ImuSimulator sim(o);
-  CHECK(sim.periodNs() == 2'500'000);
+  CHECK(sim.period_ns() == 2'500'000);
   const ImuSimulation s = sim.simulate(tr);
   REQUIRE(s.samples.size() == s.truth.size());
   CHECK(s.samples.front().t_ns == 12'500'000);  // first multiple of 2.5 ms at or after 12.3 ms
-  CHECK(s.samples.back().t_ns <= std::llround(tr.tMax() * 1e9));
-  CHECK(s.samples.back().t_ns + sim.periodNs() > std::llround(tr.tMax() * 1e9));
+  CHECK(s.samples.back().t_ns <= std::llround(tr.t_max() * 1e9));
+  CHECK(s.samples.back().t_ns + sim.period_ns() > std::llround(tr.t_max() * 1e9));
   for (size_t k = 0; k < s.samples.size(); ++k) {
     CHECK(s.truth[k].t_ns == s.samples[k].t_ns);
-    if (k > 0) CHECK(s.samples[k].t_ns - s.samples[k - 1].t_ns == sim.periodNs());
+    if (k > 0) CHECK(s.samples[k].t_ns - s.samples[k - 1].t_ns == sim.period_ns());
     CHECK(s.truth[k].has_velocity);
     CHECK(s.truth[k].has_biases);
   }
@@ -205,7 +205,7 @@ TEST_CASE("IMU timestamps and ground truth line up", "[sim][imu_simulator]") {
   CHECK((s.truth[mid].p_wb - tr.position(t)).norm() < 1e-12);
   CHECK((s.truth[mid].v_wb - tr.velocity(t)).norm() < 1e-12);
   CHECK(s.truth[mid].q_wb.angularDistance(tr.orientation(t)) < 1e-12);
-  const GroundTruthState g = groundTruthAt(tr, s.truth[mid].t_ns);
+  const GroundTruthState g = ground_truth_at(tr, s.truth[mid].t_ns);
   CHECK((g.p_wb - s.truth[mid].p_wb).norm() == 0.0);
   CHECK_FALSE(g.has_biases);
 
@@ -214,7 +214,7 @@ TEST_CASE("IMU timestamps and ground truth line up", "[sim][imu_simulator]") {
 }
 
 TEST_CASE("IMU white noise has the configured density", "[sim][imu_simulator]") {
-  const SmoothTrajectory tr = still(200.0, so3::fromYawPitchRoll(0.4, 0.1, 0.2));
+  const SmoothTrajectory tr = still(200.0, so3::from_yaw_pitch_roll(0.4, 0.1, 0.2));
   ImuSimulatorOptions o;
   o.noise.acc_random_walk = o.noise.gyr_random_walk = 0.0;  // isolate the white noise
   o.noise.acc_bias_initial = Eigen::Vector3d(0.1, -0.2, 0.05);
@@ -230,7 +230,7 @@ TEST_CASE("IMU white noise has the configured density", "[sim][imu_simulator]") 
                   vg = Eigen::Vector3d::Zero(), ca = Eigen::Vector3d::Zero();
   std::vector<Eigen::Vector3d> na(n), ng(n);
   for (size_t k = 0; k < n; ++k) {
-    const ImuSample ideal = sim.idealSample(tr, s.samples[k].t_ns * 1e-9);
+    const ImuSample ideal = sim.ideal_sample(tr, s.samples[k].t_ns * 1e-9);
     na[k] = s.samples[k].acc - ideal.acc - s.truth[k].bias_acc;
     ng[k] = s.samples[k].gyr - ideal.gyr - s.truth[k].bias_gyr;
     CHECK(s.truth[k].bias_acc == o.noise.acc_bias_initial);
@@ -268,7 +268,7 @@ TEST_CASE("IMU bias random walk grows with the configured density", "[sim][imu_s
   // Without white noise the measurement is truth + bias exactly, and the ground truth carries that bias.
   double worst = 0.0;
   for (size_t k = 0; k < n; k += 97) {
-    const ImuSample ideal = sim.idealSample(tr, s.samples[k].t_ns * 1e-9);
+    const ImuSample ideal = sim.ideal_sample(tr, s.samples[k].t_ns * 1e-9);
     worst = std::max(worst, (s.samples[k].acc - ideal.acc - s.truth[k].bias_acc).norm());
     worst = std::max(worst, (s.samples[k].gyr - ideal.gyr - s.truth[k].bias_gyr).norm());
   }

@@ -21,23 +21,23 @@ using namespace dynavins::sim;
 namespace {
 
 const World& static_street() {
-  static const World w = [] {
+  static const World kWorld = [] {
     StreetSceneOptions o;
     o.moving_vehicles = false;
     o.x_max = 100.0;
     return make_street_scene(o);
   }();
-  return w;
+  return kWorld;
 }
 
 const World& busy_street() {
-  static const World w = [] {
+  static const World kWorld = [] {
     StreetSceneOptions o;
     o.truck_start_x = 5.0;  // truck 8 m ahead at t = 1
     o.x_max = 100.0;
     return make_street_scene(o);
   }();
-  return w;
+  return kWorld;
 }
 
 double percentile(std::vector<double> v, double q) {

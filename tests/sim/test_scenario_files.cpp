@@ -74,7 +74,7 @@ TEST_CASE("The `mav` scenes fly EuRoC V1_02 with the camera where EuRoC's cam0 l
   const auto spec = load_scenario((kScenarios / "mav_none.yaml").string());
   REQUIRE(spec.tum_body_axes == "euroc");
   const auto body = build_body_trajectory(spec);
-  const auto file = readTumTrajectory(spec.tum_file);
+  const auto file = read_tum_trajectory(spec.tum_file);
   // cam0's axes in the EuRoC IMU frame: the rotation of T_BS in mav0/cam0/sensor.yaml.
   Eigen::Matrix3d R_B_cam;
   R_B_cam << 0.0148655429818, -0.999880929698, 0.00414029679422,  //

@@ -12,7 +12,7 @@ namespace so3 = dynavins::so3;
 
 namespace {
 
-SmoothTrajectory randomTrajectory(double t0, double dt, int n, uint64_t seed) {
+SmoothTrajectory random_trajectory(double t0, double dt, int n, uint64_t seed) {
   std::mt19937_64 rng(seed);
   std::uniform_real_distribution<double> u(-1.0, 1.0);
   std::vector<Eigen::Vector3d> p;
@@ -25,16 +25,16 @@ SmoothTrajectory randomTrajectory(double t0, double dt, int n, uint64_t seed) {
 }  // namespace
 
 TEST_CASE("SmoothTrajectory derivatives match numeric differentiation", "[sim][smooth_trajectory]") {
-  const SmoothTrajectory tr = randomTrajectory(5.0, 0.2, 12, 21);
+  const SmoothTrajectory tr = random_trajectory(5.0, 0.2, 12, 21);
   const double h = 1e-5;
   double ev = 0, ea = 0, ej = 0, ew = 0, eal = 0, amax = 0;
-  for (double t = tr.tMin() + 2 * h; t < tr.tMax() - 2 * h; t += 0.0173) {
+  for (double t = tr.t_min() + 2 * h; t < tr.t_max() - 2 * h; t += 0.0173) {
     const KinematicState s = tr.evaluate(t), m = tr.evaluate(t - h), p = tr.evaluate(t + h);
     ev = std::max(ev, ((p.p_w - m.p_w) / (2 * h) - s.v_w).norm());
     ea = std::max(ea, ((p.v_w - m.v_w) / (2 * h) - s.a_w).norm());
     // Jerk is piecewise constant: the central difference is exact away from knots, skip straddling ones.
-    const double u = (t - tr.tMin()) / tr.knotSpacing();
-    if (std::abs(u - std::round(u)) * tr.knotSpacing() > 2 * h) ej = std::max(ej, ((p.a_w - m.a_w) / (2 * h) - s.j_w).norm());
+    const double u = (t - tr.t_min()) / tr.knot_spacing();
+    if (std::abs(u - std::round(u)) * tr.knot_spacing() > 2 * h) ej = std::max(ej, ((p.a_w - m.a_w) / (2 * h) - s.j_w).norm());
     ew = std::max(ew, (so3::log(m.R_wb.transpose() * p.R_wb) / (2 * h) - s.omega_b).norm());
     eal = std::max(eal, ((p.omega_b - m.omega_b) / (2 * h) - s.alpha_b).norm());
     amax = std::max(amax, s.a_w.norm());
@@ -43,7 +43,7 @@ TEST_CASE("SmoothTrajectory derivatives match numeric differentiation", "[sim][s
     CHECK((tr.velocity(t) - s.v_w).norm() == 0.0);
     CHECK((tr.acceleration(t) - s.a_w).norm() == 0.0);
     CHECK((tr.rotation(t) - s.R_wb).norm() == 0.0);
-    CHECK((tr.angularVelocity(t) - s.omega_b).norm() == 0.0);
+    CHECK((tr.angular_velocity(t) - s.omega_b).norm() == 0.0);
   }
   INFO("max |a| " << amax << "; errors v " << ev << " a " << ea << " j " << ej << " ω " << ew << " α " << eal);
   CHECK(amax > 10.0);
@@ -56,7 +56,7 @@ TEST_CASE("SmoothTrajectory derivatives match numeric differentiation", "[sim][s
 }
 
 TEST_CASE("SmoothTrajectory is C2 at the knots", "[sim][smooth_trajectory]") {
-  const SmoothTrajectory tr = randomTrajectory(0.0, 0.1, 9, 4);
+  const SmoothTrajectory tr = random_trajectory(0.0, 0.1, 9, 4);
   double jump_j = 0.0;
   for (int k = 1; k < 6; ++k) {
     // Either side of the knot by 1e-12 s: a continuous quantity moves by at most 2e-12 times its rate of
@@ -74,11 +74,11 @@ TEST_CASE("SmoothTrajectory is C2 at the knots", "[sim][smooth_trajectory]") {
 }
 
 TEST_CASE("SmoothTrajectory range, pose and time shift", "[sim][smooth_trajectory]") {
-  const SmoothTrajectory tr = randomTrajectory(1.0, 0.25, 7, 9);
-  CHECK(tr.tMin() == 1.0);
-  CHECK(tr.tMax() == Approx(2.0));
+  const SmoothTrajectory tr = random_trajectory(1.0, 0.25, 7, 9);
+  CHECK(tr.t_min() == 1.0);
+  CHECK(tr.t_max() == Approx(2.0));
   CHECK(tr.duration() == Approx(1.0));
-  CHECK(tr.knotSpacing() == 0.25);
+  CHECK(tr.knot_spacing() == 0.25);
   CHECK_THROWS_AS(tr.evaluate(0.99), std::out_of_range);
   CHECK_THROWS_AS(tr.evaluate(2.01), std::out_of_range);
   CHECK_NOTHROW(tr.evaluate(2.0 + 1e-10));
@@ -88,8 +88,8 @@ TEST_CASE("SmoothTrajectory range, pose and time shift", "[sim][smooth_trajector
   CHECK((T.linear() - tr.rotation(1.3)).norm() == 0.0);
   CHECK(tr.orientation(1.3).angularDistance(Eigen::Quaterniond(tr.rotation(1.3))) < 1e-12);
 
-  const SmoothTrajectory sh = tr.shiftedInTime(-1.0);
-  CHECK(sh.tMin() == 0.0);
+  const SmoothTrajectory sh = tr.shifted_in_time(-1.0);
+  CHECK(sh.t_min() == 0.0);
   for (double t : {0.0, 0.33, 0.99}) {
     const KinematicState a = sh.evaluate(t), b = tr.evaluate(t + 1.0);
     CHECK((a.p_w - b.p_w).norm() < 1e-12);
@@ -98,5 +98,5 @@ TEST_CASE("SmoothTrajectory range, pose and time shift", "[sim][smooth_trajector
   }
 
   // Splines on different knot grids cannot form one trajectory.
-  CHECK_THROWS_AS(SmoothTrajectory(tr.positionSpline(), sh.orientationSpline()), std::invalid_argument);
+  CHECK_THROWS_AS(SmoothTrajectory(tr.position_spline(), sh.orientation_spline()), std::invalid_argument);
 }

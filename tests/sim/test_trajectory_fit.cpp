@@ -1,4 +1,4 @@
-// fitTrajectory: exact recovery of a spline from its own samples, noise suppression at the level the
+// fit_trajectory: exact recovery of a spline from its own samples, noise suppression at the level the
 // noise model predicts, and rejection of bad input.
 #include <catch2/catch.hpp>
 
@@ -14,7 +14,7 @@ namespace so3 = dynavins::so3;
 namespace {
 
 // A smooth, lively reference motion (about 1 m/s, 1 rad/s) as a spline with knot spacing 0.05 s.
-SmoothTrajectory referenceTrajectory() {
+SmoothTrajectory reference_trajectory() {
   const double dt = 0.05;
   std::vector<Eigen::Vector3d> p;
   std::vector<Eigen::Matrix3d> r;
@@ -30,7 +30,7 @@ std::vector<TimedPose> sample(const SmoothTrajectory& tr, double rate) {
   std::vector<TimedPose> out;
   const int n = static_cast<int>(std::floor(tr.duration() * rate + 1e-9));
   for (int m = 0; m <= n; ++m) {
-    const double t = tr.tMin() + m / rate;
+    const double t = tr.t_min() + m / rate;
     out.push_back({t, tr.position(t), tr.orientation(t)});
   }
   return out;
@@ -38,21 +38,21 @@ std::vector<TimedPose> sample(const SmoothTrajectory& tr, double rate) {
 
 }  // namespace
 
-TEST_CASE("fitTrajectory recovers a spline from its own exact samples", "[sim][trajectory_fit]") {
-  const SmoothTrajectory ref = referenceTrajectory();
+TEST_CASE("fit_trajectory recovers a spline from its own exact samples", "[sim][trajectory_fit]") {
+  const SmoothTrajectory ref = reference_trajectory();
   const std::vector<TimedPose> data = sample(ref, 200.0);
   TrajectoryFitReport rep;
-  const SmoothTrajectory fit = fitTrajectory(data, {}, &rep);  // defaults: same 0.05 s knots
+  const SmoothTrajectory fit = fit_trajectory(data, {}, &rep);  // defaults: same 0.05 s knots
   CHECK(rep.knot_spacing == Approx(0.05).epsilon(1e-12));
   CHECK(rep.converged);
   INFO("residual pos " << rep.position_rms << " m, rot " << rep.rotation_rms << " rad, GN iterations "
                        << rep.gauss_newton_iterations);
   // Interior and the first/last 0.2 s apart: at the ends only one side holds data, so the prior has more say.
   double ea = 0.0, ew = 0.0, ea_end = 0.0, ew_end = 0.0;
-  for (double t = 0.0; t <= ref.tMax(); t += 0.01) {
+  for (double t = 0.0; t <= ref.t_max(); t += 0.01) {
     const double e_a = (fit.acceleration(t) - ref.acceleration(t)).norm();
-    const double e_w = (fit.angularVelocity(t) - ref.angularVelocity(t)).norm();
-    const bool end = t < 0.2 || t > ref.tMax() - 0.2;
+    const double e_w = (fit.angular_velocity(t) - ref.angular_velocity(t)).norm();
+    const bool end = t < 0.2 || t > ref.t_max() - 0.2;
     (end ? ea_end : ea) = std::max(end ? ea_end : ea, e_a);
     (end ? ew_end : ew) = std::max(end ? ew_end : ew, e_w);
   }
@@ -68,8 +68,8 @@ TEST_CASE("fitTrajectory recovers a spline from its own exact samples", "[sim][t
   CHECK(rep.gauss_newton_iterations <= 6);
 }
 
-TEST_CASE("fitTrajectory averages measurement noise instead of following it", "[sim][trajectory_fit]") {
-  const SmoothTrajectory ref = referenceTrajectory();
+TEST_CASE("fit_trajectory averages measurement noise instead of following it", "[sim][trajectory_fit]") {
+  const SmoothTrajectory ref = reference_trajectory();
   std::vector<TimedPose> data = sample(ref, 200.0);
   const double sp = 1e-3, sr = 2e-3;  // the default noise model of the fit
   std::mt19937_64 rng(99);
@@ -79,19 +79,19 @@ TEST_CASE("fitTrajectory averages measurement noise instead of following it", "[
     s.q = Eigen::Quaterniond(s.q.toRotationMatrix() * so3::exp(sr * Eigen::Vector3d(n01(rng), n01(rng), n01(rng))));
   }
   TrajectoryFitReport rep;
-  const SmoothTrajectory fit = fitTrajectory(data, {}, &rep);
+  const SmoothTrajectory fit = fit_trajectory(data, {}, &rep);
   TrajectoryFitOptions wide;
   wide.knot_spacing = 0.2;
-  const SmoothTrajectory fit_wide = fitTrajectory(data, wide);
+  const SmoothTrajectory fit_wide = fit_trajectory(data, wide);
   double ep = 0, er = 0, ea = 0, ew = 0, ea_wide = 0, ew_wide = 0;
   int n = 0;
   for (const TimedPose& s : data) {
     ep += (fit.position(s.t) - ref.position(s.t)).squaredNorm();
     er += so3::log(fit.rotation(s.t).transpose() * ref.rotation(s.t)).squaredNorm();
     ea += (fit.acceleration(s.t) - ref.acceleration(s.t)).squaredNorm();
-    ew += (fit.angularVelocity(s.t) - ref.angularVelocity(s.t)).squaredNorm();
+    ew += (fit.angular_velocity(s.t) - ref.angular_velocity(s.t)).squaredNorm();
     ea_wide += (fit_wide.acceleration(s.t) - ref.acceleration(s.t)).squaredNorm();
-    ew_wide += (fit_wide.angularVelocity(s.t) - ref.angularVelocity(s.t)).squaredNorm();
+    ew_wide += (fit_wide.angular_velocity(s.t) - ref.angular_velocity(s.t)).squaredNorm();
     ++n;
   }
   ep = std::sqrt(ep / n);
@@ -121,7 +121,7 @@ TEST_CASE("fitTrajectory averages measurement noise instead of following it", "[
   CHECK(ew_wide < 0.02);
 }
 
-TEST_CASE("fitTrajectory fills sparse samples with the minimum-jerk curve", "[sim][trajectory_fit]") {
+TEST_CASE("fit_trajectory fills sparse samples with the minimum-jerk curve", "[sim][trajectory_fit]") {
   // Three poses 2 s apart. The jerk prior's minimiser through three points is the quadratic through them
   // (zero jerk, zero residual; a cubic B-spline represents it exactly): x = t, y = t - t^2/4, z = t(t-2)/8,
   // so a = (0, -0.5, 0.25) throughout; the yaw 0, 1, 2 rad is linear in time: ω = (0, 0, 0.5), α = 0.
@@ -129,7 +129,7 @@ TEST_CASE("fitTrajectory fills sparse samples with the minimum-jerk curve", "[si
                               {2.0, Eigen::Vector3d(2, 1, 0), Eigen::Quaterniond(so3::exp(Eigen::Vector3d(0, 0, 1)))},
                               {4.0, Eigen::Vector3d(4, 0, 1), Eigen::Quaterniond(so3::exp(Eigen::Vector3d(0, 0, 2)))}};
   TrajectoryFitReport rep;
-  const SmoothTrajectory fit = fitTrajectory(data, {}, &rep);
+  const SmoothTrajectory fit = fit_trajectory(data, {}, &rep);
   CHECK(rep.position_max < 1e-9);
   CHECK(rep.rotation_max < 1e-9);
   for (double t = 0; t <= 4.0; t += 0.01) {
@@ -142,22 +142,22 @@ TEST_CASE("fitTrajectory fills sparse samples with the minimum-jerk curve", "[si
   }
 }
 
-TEST_CASE("fitTrajectory rejects bad input with the offending index", "[sim][trajectory_fit]") {
+TEST_CASE("fit_trajectory rejects bad input with the offending index", "[sim][trajectory_fit]") {
   const TimedPose a{0.0, Eigen::Vector3d::Zero(), Eigen::Quaterniond::Identity()};
-  CHECK_THROWS_AS(fitTrajectory({a}), std::invalid_argument);
+  CHECK_THROWS_AS(fit_trajectory({a}), std::invalid_argument);
   TimedPose b = a;
   b.t = 0.0;
-  CHECK_THROWS_WITH(fitTrajectory({a, b}), Catch::Contains("pose 1") && Catch::Contains("increasing"));
+  CHECK_THROWS_WITH(fit_trajectory({a, b}), Catch::Contains("pose 1") && Catch::Contains("increasing"));
   b.t = 0.1;
   b.q = Eigen::Quaterniond(0.5, 0.5, 0.5, 0.6);
-  CHECK_THROWS_WITH(fitTrajectory({a, b}), Catch::Contains("unit"));
+  CHECK_THROWS_WITH(fit_trajectory({a, b}), Catch::Contains("unit"));
   b.q = Eigen::Quaterniond(so3::exp(Eigen::Vector3d(0, 0, 3.0)));
-  CHECK_THROWS_WITH(fitTrajectory({a, b}), Catch::Contains("ambiguous"));
+  CHECK_THROWS_WITH(fit_trajectory({a, b}), Catch::Contains("ambiguous"));
   b.q.setIdentity();
   b.p.x() = std::nan("");
-  CHECK_THROWS_WITH(fitTrajectory({a, b}), Catch::Contains("non-finite"));
+  CHECK_THROWS_WITH(fit_trajectory({a, b}), Catch::Contains("non-finite"));
   b.p.x() = 0.0;
   TrajectoryFitOptions o;
   o.knot_spacing = 0.0;
-  CHECK_THROWS_AS(fitTrajectory({a, b}, o), std::invalid_argument);
+  CHECK_THROWS_AS(fit_trajectory({a, b}, o), std::invalid_argument);
 }

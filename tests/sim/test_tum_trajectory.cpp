@@ -27,7 +27,7 @@ struct TempFile {
   explicit TempFile(const std::string& name) : path("/tmp/dynavins_test_tum_" + std::to_string(getpid()) + "_" + name) {}
   ~TempFile() { std::remove(path.c_str()); }
   void write(const std::string& text) const { std::ofstream(path) << text; }
-  void writeGz(const std::string& text) const {
+  void write_gz(const std::string& text) const {
     gzFile f = gzopen(path.c_str(), "wb");
     gzwrite(f, text.data(), static_cast<unsigned>(text.size()));
     gzclose(f);
@@ -41,9 +41,9 @@ const char* kGood =
     "100.5 1.5 2 3 0 0 0.7071068 0.7071068\n"
     "101.0 2 2 3 0 0 1 0";
 
-std::string errorOf(const std::string& path) {
+std::string error_of(const std::string& path) {
   try {
-    readTumTrajectory(path);
+    read_tum_trajectory(path);
   } catch (const std::runtime_error& e) {
     return e.what();
   }
@@ -55,7 +55,7 @@ struct RealImu {
   std::vector<int64_t> t;
   std::vector<Eigen::Vector3d> gyr, acc;
 };
-RealImu readEurocImu(const std::string& path) {
+RealImu read_euroc_imu(const std::string& path) {
   std::ifstream in(path);
   REQUIRE(in.good());
   RealImu r;
@@ -77,11 +77,11 @@ RealImu readEurocImu(const std::string& path) {
 
 }  // namespace
 
-TEST_CASE("readTumTrajectory reads plain and gzip files alike", "[sim][tum_trajectory]") {
+TEST_CASE("read_tum_trajectory reads plain and gzip files alike", "[sim][tum_trajectory]") {
   TempFile plain("good.txt"), gz("good.txt.gz");
   plain.write(kGood);
-  gz.writeGz(kGood);
-  const std::vector<TimedPose> a = readTumTrajectory(plain.path), b = readTumTrajectory(gz.path);
+  gz.write_gz(kGood);
+  const std::vector<TimedPose> a = read_tum_trajectory(plain.path), b = read_tum_trajectory(gz.path);
   REQUIRE(a.size() == 3);  // comment and blank line skipped, last line without newline kept
   REQUIRE(b.size() == 3);
   for (size_t i = 0; i < 3; ++i) {
@@ -96,8 +96,8 @@ TEST_CASE("readTumTrajectory reads plain and gzip files alike", "[sim][tum_traje
   CHECK(std::abs(a[1].q.norm() - 1.0) < 1e-15);
 }
 
-TEST_CASE("readTumTrajectory reads a real EuRoC ground truth file", "[sim][tum_trajectory]") {
-  const std::vector<TimedPose> p = readTumTrajectory(kTraj + "euroc_tum/MH_01_easy.txt.gz");
+TEST_CASE("read_tum_trajectory reads a real EuRoC ground truth file", "[sim][tum_trajectory]") {
+  const std::vector<TimedPose> p = read_tum_trajectory(kTraj + "euroc_tum/MH_01_easy.txt.gz");
   // 181.9 s at 200 Hz; first row: 1403636580.83856 4.688319 -1.786938 0.783338 -0.153029 -0.827383 -0.082152 0.534108
   CHECK(p.size() == 36382);
   CHECK(p.front().t == 1403636580.83856);
@@ -106,45 +106,45 @@ TEST_CASE("readTumTrajectory reads a real EuRoC ground truth file", "[sim][tum_t
   CHECK(p.back().t - p.front().t == Approx(181.9).margin(0.05));
 }
 
-TEST_CASE("readTumTrajectory names file and line of bad input", "[sim][tum_trajectory]") {
+TEST_CASE("read_tum_trajectory names file and line of bad input", "[sim][tum_trajectory]") {
   TempFile f("bad.txt");
   f.write("# header\n1.0 0 0 0 0 0 0 1\n2.0 0 0 0 0 0 1\n");
-  std::string e = errorOf(f.path);
+  std::string e = error_of(f.path);
   CHECK_THAT(e, Catch::Contains(f.path + ":3:") && Catch::Contains("8 columns"));
 
   f.write("1.0 0 0 0 0 0 0 1\n2.0 0 zero 0 0 0 0 1\n");
-  CHECK_THAT(errorOf(f.path), Catch::Contains(":2:") && Catch::Contains("column 3") && Catch::Contains("zero"));
+  CHECK_THAT(error_of(f.path), Catch::Contains(":2:") && Catch::Contains("column 3") && Catch::Contains("zero"));
 
   f.write("1.0 0 0 0 0 0 0 1\n2.0 0 0 0 0 0 0 1\n1.5 0 0 0 0 0 0 1\n");
-  CHECK_THAT(errorOf(f.path), Catch::Contains(":3:") && Catch::Contains("goes back"));
+  CHECK_THAT(error_of(f.path), Catch::Contains(":3:") && Catch::Contains("goes back"));
 
   f.write("1.0 0 0 0 0 0 0 1\n1.0 0 0 0 0 0 0 1\n");
-  CHECK_THAT(errorOf(f.path), Catch::Contains(":2:"));
+  CHECK_THAT(error_of(f.path), Catch::Contains(":2:"));
 
   f.write("1.0 0 0 0 0 0 0 2\n");
-  CHECK_THAT(errorOf(f.path), Catch::Contains(":1:") && Catch::Contains("quaternion"));
+  CHECK_THAT(error_of(f.path), Catch::Contains(":1:") && Catch::Contains("quaternion"));
 
   f.write("1.0 0 0 nan 0 0 0 1\n");
-  CHECK_THAT(errorOf(f.path), Catch::Contains(":1:") && Catch::Contains("finite"));
+  CHECK_THAT(error_of(f.path), Catch::Contains(":1:") && Catch::Contains("finite"));
 
   f.write("# only a comment\n");
-  CHECK_THAT(errorOf(f.path), Catch::Contains("no poses"));
+  CHECK_THAT(error_of(f.path), Catch::Contains("no poses"));
 
-  CHECK_THAT(errorOf("/nonexistent/dir/traj.txt"), Catch::Contains("/nonexistent/dir/traj.txt") && Catch::Contains("no such file"));
+  CHECK_THAT(error_of("/nonexistent/dir/traj.txt"), Catch::Contains("/nonexistent/dir/traj.txt") && Catch::Contains("no such file"));
 
   // A truncated gzip stream is a read error, not a silently shorter trajectory.
   TempFile gz("trunc.txt.gz");
   std::string big;
   for (int i = 0; i < 2000; ++i) big += std::to_string(i) + ".0 1 2 3 0 0 0 1\n";
-  gz.writeGz(big);
+  gz.write_gz(big);
   std::ifstream in(gz.path, std::ios::binary);
   std::string bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
   in.close();
   std::ofstream(gz.path, std::ios::binary) << bytes.substr(0, bytes.size() / 2);
-  CHECK_THAT(errorOf(gz.path), Catch::Contains(gz.path) && Catch::Contains("read error"));
+  CHECK_THAT(error_of(gz.path), Catch::Contains(gz.path) && Catch::Contains("read error"));
 }
 
-TEST_CASE("removePositionJumps removes steps and outliers but keeps hard motion", "[sim][tum_trajectory]") {
+TEST_CASE("remove_position_jumps removes steps and outliers but keeps hard motion", "[sim][tum_trajectory]") {
   // 200 Hz, 1 m/s along x, a vertical bump of 10 g peak acceleration starting abruptly (real, violent
   // motion), then a 5 cm step and a 2 cm single-sample outlier (glitches).
   const double kPi = 3.14159265358979323846, f = 7.0, amp = 0.05;  // peak acc amp (2 pi f)^2 = 96.7 m/s^2
@@ -159,26 +159,26 @@ TEST_CASE("removePositionJumps removes steps and outliers but keeps hard motion"
     p.push_back(s);
   }
   std::vector<TimedPose> q = p;
-  CHECK(removePositionJumps(q, 50.0) == 3);  // the step, and the outlier's way out and back
+  CHECK(remove_position_jumps(q, 50.0) == 3);  // the step, and the outlier's way out and back
   for (size_t m = 0; m < q.size(); ++m) {
     INFO("sample " << m);
     CHECK(std::abs(q[m].p.y()) < 1e-12);
     CHECK(std::abs(q[m].p.z() - bump(q[m].t)) < 1e-12);
   }
   q = p;
-  CHECK(removePositionJumps(q, 0.0) == 0);  // disabled
+  CHECK(remove_position_jumps(q, 0.0) == 0);  // disabled
 }
 
-TEST_CASE("fitTumTrajectory window, time shift and residual on real EuRoC data", "[sim][tum_trajectory]") {
+TEST_CASE("fit_tum_trajectory window, time shift and residual on real EuRoC data", "[sim][tum_trajectory]") {
   const std::string path = kTraj + "euroc_tum/V1_02_medium.txt.gz";
-  const std::vector<TimedPose> all = readTumTrajectory(path);
+  const std::vector<TimedPose> all = read_tum_trajectory(path);
   TumFitOptions o;
   o.window_start = 20.0;
   o.window_duration = 10.0;
   TumFitReport rep;
-  const SmoothTrajectory tr = fitTumTrajectory(path, o, &rep);
-  const std::vector<TimedPose> win = selectWindow(all, 20.0, 10.0);
-  CHECK(tr.tMin() == 0.0);
+  const SmoothTrajectory tr = fit_tum_trajectory(path, o, &rep);
+  const std::vector<TimedPose> win = select_window(all, 20.0, 10.0);
+  CHECK(tr.t_min() == 0.0);
   CHECK(tr.duration() == Approx(win.back().t - win.front().t));
   CHECK(rep.time_offset == win.front().t);
   CHECK(rep.fit.num_samples == static_cast<int>(win.size()));
@@ -199,26 +199,26 @@ TEST_CASE("fitTumTrajectory window, time shift and residual on real EuRoC data",
   TumFitOptions keep = o;
   keep.shift_to_zero = false;
   TumFitReport rep2;
-  const SmoothTrajectory tr2 = fitTumTrajectory(path, keep, &rep2);
+  const SmoothTrajectory tr2 = fit_tum_trajectory(path, keep, &rep2);
   CHECK(rep2.time_offset == 0.0);
-  CHECK(tr2.tMin() == win.front().t);
+  CHECK(tr2.t_min() == win.front().t);
 
   o.window_start = 1000.0;
-  CHECK_THROWS_AS(fitTumTrajectory(path, o), std::invalid_argument);
+  CHECK_THROWS_AS(fit_tum_trajectory(path, o), std::invalid_argument);
 }
 
-TEST_CASE("fitTumTrajectory places the file's world in ours and renames the body axes", "[sim][tum_trajectory]") {
+TEST_CASE("fit_tum_trajectory places the file's world in ours and renames the body axes", "[sim][tum_trajectory]") {
   const std::string path = kTraj + "euroc_tum/V1_02_medium.txt.gz";
   TumFitOptions o;
   o.window_start = 20.0;
   o.window_duration = 5.0;
   TumFitReport rep;
-  const SmoothTrajectory plain = fitTumTrajectory(path, o, &rep);
+  const SmoothTrajectory plain = fit_tum_trajectory(path, o, &rep);
   TumFitOptions placed = o;
   placed.world_from_file.linear() = Eigen::AngleAxisd(0.7, Eigen::Vector3d::UnitZ()).toRotationMatrix();
   placed.world_from_file.translation() = Eigen::Vector3d(20, -3, 0.5);
   placed.file_body_from_body << 0, 0, 1, 0, -1, 0, 1, 0, 0;
-  const SmoothTrajectory moved = fitTumTrajectory(path, placed);
+  const SmoothTrajectory moved = fit_tum_trajectory(path, placed);
   for (double t : {0.5, 2.0, 4.5}) {
     INFO("t = " << t);
     // The body origin moves with the world; the body axes are renamed, not moved.
@@ -226,21 +226,21 @@ TEST_CASE("fitTumTrajectory places the file's world in ours and renames the body
     const Eigen::Matrix3d expect = placed.world_from_file.linear() * plain.rotation(t) * placed.file_body_from_body;
     CHECK(Eigen::AngleAxisd(moved.rotation(t).transpose() * expect).angle() < 1e-6);
     // The IMU sees the same motion in the renamed axes: ω_new = R_bodyᵀ ω_file.
-    CHECK((moved.angularVelocity(t) - placed.file_body_from_body.transpose() * plain.angularVelocity(t)).norm() <
+    CHECK((moved.angular_velocity(t) - placed.file_body_from_body.transpose() * plain.angular_velocity(t)).norm() <
           1e-5);
   }
 }
 
-TEST_CASE("fitTumTrajectory removes EuRoC MH_04's 13 cm ground-truth glitch", "[sim][tum_trajectory]") {
+TEST_CASE("fit_tum_trajectory removes EuRoC MH_04's 13 cm ground-truth glitch", "[sim][tum_trajectory]") {
   // MH_04_difficult has a position step of 13 cm within 5 ms at 45.005 s after its start.
   const std::string path = kTraj + "euroc_tum/MH_04_difficult.txt.gz";
   TumFitOptions o;
   o.window_start = 40.0;
   o.window_duration = 10.0;
   TumFitReport on, off;
-  fitTumTrajectory(path, o, &on);
+  fit_tum_trajectory(path, o, &on);
   o.glitch_acceleration = 0.0;
-  fitTumTrajectory(path, o, &off);
+  fit_tum_trajectory(path, o, &off);
   INFO("with removal: " << on.removed_jumps << " glitches, max |a| " << on.fit.max_acceleration << " m/s^2, max residual "
                         << on.fit.position_max << " m; without: max |a| " << off.fit.max_acceleration
                         << " m/s^2, max residual " << off.fit.position_max << " m");
@@ -258,16 +258,16 @@ TEST_CASE("IMU simulated from EuRoC V1_01 ground truth matches the real ADIS1644
   TumFitOptions o;
   o.shift_to_zero = false;
   TumFitReport rep;
-  const SmoothTrajectory tr = fitTumTrajectory(kTraj + "euroc_tum/V1_01_easy_vicon2gt_20hz.txt.gz", o, &rep);
-  const RealImu real = readEurocImu(std::string(DYNAVINS_SHARED_DIR) + "/data/euroc_v1_01_micro/mav0/imu0/data.csv");
+  const SmoothTrajectory tr = fit_tum_trajectory(kTraj + "euroc_tum/V1_01_easy_vicon2gt_20hz.txt.gz", o, &rep);
+  const RealImu real = read_euroc_imu(std::string(DYNAVINS_SHARED_DIR) + "/data/euroc_v1_01_micro/mav0/imu0/data.csv");
   ImuSimulatorOptions so;
-  so.noise = ImuNoiseModel::noiseFree();
+  so.noise = ImuNoiseModel::noise_free();
   const ImuSimulator sim(so);
   std::vector<Eigen::Vector3d> rg, ra, sg, sa;
   for (size_t k = 0; k < real.t.size(); ++k) {
     const double t = real.t[k] * 1e-9;
-    if (t < tr.tMin() + 1.0 || t > tr.tMax() - 1.0) continue;
-    const dynavins::ImuSample s = sim.idealSample(tr, t);
+    if (t < tr.t_min() + 1.0 || t > tr.t_max() - 1.0) continue;
+    const dynavins::ImuSample s = sim.ideal_sample(tr, t);
     rg.push_back(real.gyr[k]);
     ra.push_back(real.acc[k]);
     sg.push_back(s.gyr);
@@ -329,7 +329,7 @@ TEST_CASE("Fitted EuRoC velocity agrees with the velocity of the ground-truth cs
   // ~2 pi 10 Hz * 1e-4 m ~ 0.006 m/s, so 0.03 m/s RMS is a generous bound (the motion reaches ~1.5 m/s).
   TumFitOptions o;
   o.shift_to_zero = false;
-  const SmoothTrajectory tr = fitTumTrajectory(kTraj + "euroc_tum/V1_02_medium.txt.gz", o);
+  const SmoothTrajectory tr = fit_tum_trajectory(kTraj + "euroc_tum/V1_02_medium.txt.gz", o);
   gzFile f = gzopen((kTraj + "euroc_state_csv/V1_02_medium.csv.gz").c_str(), "rb");
   REQUIRE(f != nullptr);
   char buf[1024];
@@ -346,7 +346,7 @@ TEST_CASE("Fitted EuRoC velocity agrees with the velocity of the ground-truth cs
     ss >> t_ns;
     for (double& x : v) ss >> x;
     const double t = t_ns * 1e-9;
-    if (t < tr.tMin() + 0.5 || t > tr.tMax() - 0.5) continue;
+    if (t < tr.t_min() + 0.5 || t > tr.t_max() - 0.5) continue;
     const Eigen::Vector3d v_csv(v[7], v[8], v[9]);
     e2 += (tr.velocity(t) - v_csv).squaredNorm();
     vmax = std::max(vmax, v_csv.norm());
@@ -360,10 +360,10 @@ TEST_CASE("Fitted EuRoC velocity agrees with the velocity of the ground-truth cs
   CHECK(rms < 0.03);
 }
 
-TEST_CASE("fitTumTrajectory handles TUM-VI mocap with dropouts", "[sim][tum_trajectory]") {
+TEST_CASE("fit_tum_trajectory handles TUM-VI mocap with dropouts", "[sim][tum_trajectory]") {
   // room1 is ~120 Hz with dropouts up to 1 s (no glitch removal across them) and fast hand-held motion.
   TumFitReport rep;
-  const SmoothTrajectory tr = fitTumTrajectory(kTraj + "tumvi_tum/dataset-room1_512_16.txt.gz", {}, &rep);
+  const SmoothTrajectory tr = fit_tum_trajectory(kTraj + "tumvi_tum/dataset-room1_512_16.txt.gz", {}, &rep);
   INFO("room1: " << rep.fit.num_samples << " poses, residual pos RMS " << rep.fit.position_rms << " max "
                  << rep.fit.position_max << " m, rot RMS " << rep.fit.rotation_rms << " max " << rep.fit.rotation_max
                  << " rad; glitches " << rep.removed_jumps << "; max |a| " << rep.fit.max_acceleration

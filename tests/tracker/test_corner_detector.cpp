@@ -9,6 +9,7 @@
 #include "stages/tracker/corner_detector.hpp"
 
 using namespace dynavins;
+using namespace dynavins::tracker;
 
 namespace {
 

@@ -8,6 +8,7 @@
 #include "stages/tracker/kalibr_camera.hpp"
 
 using namespace dynavins;
+using namespace dynavins::tracker;
 
 TEST_CASE("load_kalibr_camera: EuRoC cam0 intrinsics, distortion and T_BS", "[tracker][kalibr]") {
   const auto c = load_kalibr_camera(std::string(DYNAVINS_SHARED_DIR) + "/data/euroc_v1_01_micro/mav0/cam0/sensor.yaml");

@@ -1,4 +1,4 @@
-// capturePatch / refinePatch: recovering a known affine warp with gain and offset, and the failures.
+// capture_patch / refine_patch: recovering a known affine warp with gain and offset, and the failures.
 #include <cmath>
 
 #include <catch2/catch.hpp>
@@ -8,6 +8,7 @@
 #include "stages/tracker/patch_template.hpp"
 
 using namespace dynavins;
+using namespace dynavins::tracker;
 
 namespace {
 
@@ -33,10 +34,10 @@ cv::Mat warped(const cv::Mat& img, const cv::Matx23d& M, double gain, double off
 
 }  // namespace
 
-TEST_CASE("refinePatch recovers an affine warp with a gain and an offset", "[tracker][patch]") {
+TEST_CASE("refine_patch recovers an affine warp with a gain and an offset", "[tracker][patch]") {
   const cv::Mat a = texture(1);
   const Eigen::Vector2f p(160.3f, 119.6f);
-  const auto tmpl = capturePatch(a, p);
+  const auto tmpl = capture_patch(a, p);
   REQUIRE(tmpl);
   // 12 % bigger, turned 6 degrees, moved; 20 % brighter with an offset.
   const double s = 1.12, th = 6.0 * CV_PI / 180.0;
@@ -49,54 +50,54 @@ TEST_CASE("refinePatch recovers an affine warp with a gain and an offset", "[tra
   const cv::Mat b = warped(a, M, 1.2, -15.0);
   const Eigen::Vector2f truth = (p.cast<double>() + shift).cast<float>();
 
-  AffineWarp w;
+  tracker::AffineWarp w;
   w.t = truth + Eigen::Vector2f(1.5f, -1.0f);  // a KLT answer off by 1.8 px, shape unknown
-  const RefineOutcome o = refinePatch(*tmpl, b, &w, 20);
-  REQUIRE(o.result == RefineResult::Converged);
+  const tracker::RefineOutcome o = refine_patch(*tmpl, b, &w, 20);
+  REQUIRE(o.result == tracker::RefineResult::Converged);
   CHECK(o.ncc > 0.99f);
   CHECK((w.t - truth).norm() < 0.05f);
   CHECK((w.A.cast<double>() - L).norm() < 0.02);
   CHECK(w.scale() == Approx(s).epsilon(0.01));
 }
 
-TEST_CASE("refinePatch on the unchanged image stays put", "[tracker][patch]") {
+TEST_CASE("refine_patch on the unchanged image stays put", "[tracker][patch]") {
   const cv::Mat a = texture(2);
   const Eigen::Vector2f p(100.7f, 80.2f);
-  const auto tmpl = capturePatch(a, p);
+  const auto tmpl = capture_patch(a, p);
   REQUIRE(tmpl);
-  AffineWarp w;
+  tracker::AffineWarp w;
   w.t = p + Eigen::Vector2f(0.6f, 0.4f);
-  REQUIRE(refinePatch(*tmpl, a, &w).result == RefineResult::Converged);
+  REQUIRE(refine_patch(*tmpl, a, &w).result == tracker::RefineResult::Converged);
   CHECK((w.t - p).norm() < 0.02f);
   CHECK((w.A - Eigen::Matrix2f::Identity()).norm() < 0.01f);
 }
 
-TEST_CASE("capturePatch refuses flat patches and the image border", "[tracker][patch]") {
+TEST_CASE("capture_patch refuses flat patches and the image border", "[tracker][patch]") {
   const cv::Mat flat(100, 100, CV_8U, cv::Scalar(128));
-  CHECK_FALSE(capturePatch(flat, Eigen::Vector2f(50, 50)));
+  CHECK_FALSE(capture_patch(flat, Eigen::Vector2f(50, 50)));
   const cv::Mat a = texture(3);
-  CHECK_FALSE(capturePatch(a, Eigen::Vector2f(5, 50)));     // patch radius 7 + 1 rim
-  CHECK_FALSE(capturePatch(a, Eigen::Vector2f(50, 232)));
-  CHECK(capturePatch(a, Eigen::Vector2f(8.5f, 50)));
+  CHECK_FALSE(capture_patch(a, Eigen::Vector2f(5, 50)));     // patch radius 7 + 1 rim
+  CHECK_FALSE(capture_patch(a, Eigen::Vector2f(50, 232)));
+  CHECK(capture_patch(a, Eigen::Vector2f(8.5f, 50)));
   cv::Mat rgb;
   cv::cvtColor(a, rgb, cv::COLOR_GRAY2BGR);
-  CHECK_FALSE(capturePatch(rgb, Eigen::Vector2f(50, 50)));
+  CHECK_FALSE(capture_patch(rgb, Eigen::Vector2f(50, 50)));
 }
 
-TEST_CASE("refinePatch reports a patch that left the image or lost its texture", "[tracker][patch]") {
+TEST_CASE("refine_patch reports a patch that left the image or lost its texture", "[tracker][patch]") {
   const cv::Mat a = texture(4);
-  const auto tmpl = capturePatch(a, Eigen::Vector2f(60, 60));
+  const auto tmpl = capture_patch(a, Eigen::Vector2f(60, 60));
   REQUIRE(tmpl);
-  AffineWarp w;
+  tracker::AffineWarp w;
   w.t = Eigen::Vector2f(3, 60);
-  CHECK(refinePatch(*tmpl, a, &w).result == RefineResult::OutOfImage);
+  CHECK(refine_patch(*tmpl, a, &w).result == tracker::RefineResult::OutOfImage);
   const cv::Mat flat(240, 320, CV_8U, cv::Scalar(90));
-  w = AffineWarp{};
+  w = tracker::AffineWarp{};
   w.t = Eigen::Vector2f(60, 60);
-  CHECK(refinePatch(*tmpl, flat, &w).result == RefineResult::Diverged);
+  CHECK(refine_patch(*tmpl, flat, &w).result == tracker::RefineResult::Diverged);
 }
 
-TEST_CASE("imageNoiseSigma measures added noise on a textured image", "[tracker][patch]") {
+TEST_CASE("image_noise_sigma measures added noise on a textured image", "[tracker][patch]") {
   const cv::Mat a = texture(5);
   for (double sigma : {2.0, 5.0}) {
     cv::Mat f, noise(a.size(), CV_32F), noisy;
@@ -104,12 +105,12 @@ TEST_CASE("imageNoiseSigma measures added noise on a textured image", "[tracker]
     cv::RNG(6).fill(noise, cv::RNG::NORMAL, 0.0, sigma);
     cv::Mat(f + noise).convertTo(noisy, CV_8U);
     // The texture leaks a little into the estimate and 8-bit rounding adds ~0.3 gray levels.
-    CHECK(imageNoiseSigma(noisy) == Approx(sigma).epsilon(0.2));
+    CHECK(image_noise_sigma(noisy) == Approx(sigma).epsilon(0.2));
   }
-  CHECK(imageNoiseSigma(a) < 1.0);
+  CHECK(image_noise_sigma(a) < 1.0);
 }
 
-TEST_CASE("refinePatch under sensor noise settles when told the noise", "[tracker][patch]") {
+TEST_CASE("refine_patch under sensor noise settles when told the noise", "[tracker][patch]") {
   // A weak texture (contrast ~10 gray levels) and noise of sigma 2 in both images.
   cv::Mat a = texture(7), weak;
   a.convertTo(weak, CV_32F, 10.0 / 255.0, 100.0);
@@ -126,15 +127,15 @@ TEST_CASE("refinePatch under sensor noise settles when told the noise", "[tracke
   int settled = 0, settled_blind = 0, near = 0, n = 0;
   for (int y = 40; y < 200; y += 20)
     for (int x = 40; x < 280; x += 20) {
-      const auto tmpl = capturePatch(first, Eigen::Vector2f(x, y));
+      const auto tmpl = capture_patch(first, Eigen::Vector2f(x, y));
       if (!tmpl) continue;
       ++n;
-      AffineWarp w, blind;
+      tracker::AffineWarp w, blind;
       w.t = blind.t = Eigen::Vector2f(x + 2.3f, y + 0.8f);
-      const RefineOutcome o = refinePatch(*tmpl, second, &w, imageNoiseSigma(second));
-      settled += o.result == RefineResult::Converged;
-      near += o.result == RefineResult::Converged && (w.t - Eigen::Vector2f(x + 2, y + 1)).norm() < 1.0f;
-      settled_blind += refinePatch(*tmpl, second, &blind).result == RefineResult::Converged;
+      const tracker::RefineOutcome o = refine_patch(*tmpl, second, &w, image_noise_sigma(second));
+      settled += o.result == tracker::RefineResult::Converged;
+      near += o.result == tracker::RefineResult::Converged && (w.t - Eigen::Vector2f(x + 2, y + 1)).norm() < 1.0f;
+      settled_blind += refine_patch(*tmpl, second, &blind).result == tracker::RefineResult::Converged;
     }
   REQUIRE(n > 50);
   CHECK(settled > 0.9 * n);

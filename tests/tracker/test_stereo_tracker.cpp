@@ -18,6 +18,7 @@
 #include "stages/tracker/stereo_tracker.hpp"
 
 using namespace dynavins;
+using namespace dynavins::tracker;
 namespace fs = std::filesystem;
 
 namespace {
@@ -80,7 +81,7 @@ struct SimRun {
 /// gyro prediction (true relative rotation), with F-RANSAC, and without the first-patch refinement
 /// (plain KLT), in one pass over the rendered frames.
 const SimRun& sim_run() {
-  static const SimRun run = [] {
+  static const SimRun kRun = [] {
     const fs::path dir = fs::temp_directory_path() / "dynavins_test_tracker";
     fs::create_directories(dir);
     const fs::path path = dir / "short.yaml";
@@ -93,10 +94,10 @@ const SimRun& sim_run() {
     SimRun r;
     r.rig = scenario->rig;
     r.cam = camera_of(r.rig.camera);
-    TrackerOptions with_f, no_patch;
+    tracker::TrackerOptions with_f, no_patch;
     with_f.f_ransac = true;
     no_patch.patch_refine = false;
-    StereoTracker plain(TrackerOptions{}, r.cam, r.cam), predicted(TrackerOptions{}, r.cam, r.cam),
+    tracker::StereoTracker plain(tracker::TrackerOptions{}, r.cam, r.cam), predicted(tracker::TrackerOptions{}, r.cam, r.cam),
         ransac(with_f, r.cam, r.cam), klt_only(no_patch, r.cam, r.cam);
     SensorEvent e;
     while (src.next(e)) {
@@ -120,7 +121,7 @@ const SimRun& sim_run() {
     }
     return r;
   }();
-  return run;
+  return kRun;
 }
 
 /// Reprojection error [px] of every later observation of a static feature, against the 3-D point
@@ -161,7 +162,7 @@ double quantile(std::vector<double> v, double q) {
 
 }  // namespace
 
-TEST_CASE("StereoTracker: ids stay on the same 3-D point (true depth and pose)", "[tracker]") {
+TEST_CASE("tracker::StereoTracker: ids stay on the same 3-D point (true depth and pose)", "[tracker]") {
   const SimRun& r = sim_run();
   for (bool with_prediction : {false, true}) {
     const auto err = with_prediction ? identity_errors(r.predicted, r.truth_predicted, r)
@@ -179,7 +180,7 @@ TEST_CASE("StereoTracker: ids stay on the same 3-D point (true depth and pose)",
   CHECK(predicted > 0);
 }
 
-TEST_CASE("StereoTracker: the first-patch refinement keeps tracks nearer their point than plain KLT", "[tracker]") {
+TEST_CASE("tracker::StereoTracker: the first-patch refinement keeps tracks nearer their point than plain KLT", "[tracker]") {
   const SimRun& r = sim_run();
   const auto refined = identity_errors(r.plain, r.truth_plain, r);
   const auto klt = identity_errors(r.klt_only, r.truth_klt_only, r);
@@ -195,7 +196,7 @@ TEST_CASE("StereoTracker: the first-patch refinement keeps tracks nearer their p
   CHECK(lost < 0.05 * tracked);  // ends few tracks
 }
 
-TEST_CASE("StereoTracker: stereo depth within a pixel of disparity of the true depth", "[tracker]") {
+TEST_CASE("tracker::StereoTracker: stereo depth within a pixel of disparity of the true depth", "[tracker]") {
   const SimRun& r = sim_run();
   const Eigen::Isometry3d T_c0_c1 = r.rig.T_body_cam0.inverse() * r.rig.T_body_cam1;
   const double fb = r.rig.camera.fx * T_c0_c1.translation().norm();
@@ -222,9 +223,9 @@ TEST_CASE("StereoTracker: stereo depth within a pixel of disparity of the true d
   CHECK(quantile(disparity_err, 0.95) < 1.0);
 }
 
-TEST_CASE("StereoTracker: track bookkeeping and length statistics", "[tracker]") {
+TEST_CASE("tracker::StereoTracker: track bookkeeping and length statistics", "[tracker]") {
   const SimRun& r = sim_run();
-  const TrackerOptions opt;
+  const tracker::TrackerOptions opt;
   std::map<int64_t, int> last_length;
   std::set<int64_t> ended;
   int64_t max_id = -1;
@@ -302,7 +303,7 @@ ObjectTracks object_tracks(const std::vector<TrackedFrame>& frames, const std::v
 
 }  // namespace
 
-TEST_CASE("StereoTracker: features on the moving truck are tracked and stay on it", "[tracker]") {
+TEST_CASE("tracker::StereoTracker: features on the moving truck are tracked and stay on it", "[tracker]") {
   const SimRun& r = sim_run();
   const ObjectTracks o = object_tracks(r.plain, r.truth_plain);
   std::printf("moving object: %d later observations, %d still on it, %d of tracks >= 5 frames\n", o.later, o.stayed,
@@ -313,7 +314,7 @@ TEST_CASE("StereoTracker: features on the moving truck are tracked and stay on i
   CHECK(o.stayed >= 0.9 * o.later);
 }
 
-TEST_CASE("StereoTracker: the optional F-matrix RANSAC rejects some tracks and keeps static identities", "[tracker]") {
+TEST_CASE("tracker::StereoTracker: the optional F-matrix RANSAC rejects some tracks and keeps static identities", "[tracker]") {
   const SimRun& r = sim_run();
   const ObjectTracks plain = object_tracks(r.plain, r.truth_plain);
   const ObjectTracks ransac = object_tracks(r.ransac, r.truth_ransac);
@@ -328,7 +329,7 @@ TEST_CASE("StereoTracker: the optional F-matrix RANSAC rejects some tracks and k
   CHECK(quantile(identity_errors(r.ransac, r.truth_ransac, r), 0.5) < 0.5);
 }
 
-TEST_CASE("StereoTracker: the gyro prediction carries tracks through a rotation beyond the pyramid", "[tracker]") {
+TEST_CASE("tracker::StereoTracker: the gyro prediction carries tracks through a rotation beyond the pyramid", "[tracker]") {
   // A pinhole image rotated by R: a pure homography K R^T K^-1, exact whatever the depth.
   sim::CameraIntrinsics c;
   const CameraModelPtr cam = camera_of(c, false);
@@ -348,7 +349,7 @@ TEST_CASE("StereoTracker: the gyro prediction carries tracks through a rotation 
   cv::warpPerspective(img, warped, Hcv, img.size(), cv::INTER_LINEAR, cv::BORDER_CONSTANT, 0);
 
   auto run = [&](bool predict, int* visible, int* correct, int* wrong) {
-    StereoTracker tracker(TrackerOptions{}, cam);
+    tracker::StereoTracker tracker(tracker::TrackerOptions{}, cam);
     StereoFrame a, b;
     a.left = img, b.left = warped, b.t_ns = 50'000'000;
     const TrackedFrame fa = tracker.process(a);
@@ -386,14 +387,14 @@ TEST_CASE("StereoTracker: the gyro prediction carries tracks through a rotation 
   CHECK(ok_plain < 0.1 * vis_plain);
 }
 
-TEST_CASE("StereoTracker: EuRoC V1_01 clip with its own radtan calibration", "[tracker][euroc]") {
+TEST_CASE("tracker::StereoTracker: EuRoC V1_01 clip with its own radtan calibration", "[tracker][euroc]") {
   const std::string dir = std::string(DYNAVINS_SHARED_DIR) + "/data/euroc_v1_01_micro";
   const io::EurocDataset data(dir);
-  const KalibrCamera c0 = load_kalibr_camera(dir + "/mav0/cam0/sensor.yaml");
-  const KalibrCamera c1 = load_kalibr_camera(dir + "/mav0/cam1/sensor.yaml");
+  const tracker::KalibrCamera c0 = load_kalibr_camera(dir + "/mav0/cam0/sensor.yaml");
+  const tracker::KalibrCamera c1 = load_kalibr_camera(dir + "/mav0/cam1/sensor.yaml");
   const Eigen::Isometry3d T_c0_c1 = c0.T_body_cam.inverse() * c1.T_body_cam;
   REQUIRE(T_c0_c1.translation().norm() == Approx(0.11).margin(0.005));  // the VI-sensor's baseline
-  StereoTracker tracker(TrackerOptions{}, c0.camera, c1.camera);
+  tracker::StereoTracker tracker(tracker::TrackerOptions{}, c0.camera, c1.camera);
   std::vector<double> depths, lengths;
   double features = 0, stereo = 0, upper = 0, upper_stereo = 0;
   for (std::size_t i = 0; i < data.frames().size(); ++i) {
@@ -417,7 +418,7 @@ TEST_CASE("StereoTracker: EuRoC V1_01 clip with its own radtan calibration", "[t
               quantile(depths, 0.5), plausible / static_cast<double>(depths.size()),
               upper_stereo / upper);
   REQUIRE(n > 50);
-  CHECK(features / n > 0.9 * TrackerOptions{}.max_cnt);
+  CHECK(features / n > 0.9 * tracker::TrackerOptions{}.max_cnt);
   // The clip starts with the MAV on the floor: the lower image is carpet under a metre away, sheared
   // between views 11 cm apart and partly hidden from cam1 by the rig, and KLT's translation-only
   // window matches little there. The upper image sees the padded walls 2-4 m away, near
@@ -432,7 +433,7 @@ TEST_CASE("StereoTracker: EuRoC V1_01 clip with its own radtan calibration", "[t
   CHECK(plausible >= 0.98 * depths.size());
 }
 
-TEST_CASE("StereoTracker: CLAHE recovers features in a dark low-contrast image", "[tracker]") {
+TEST_CASE("tracker::StereoTracker: CLAHE recovers features in a dark low-contrast image", "[tracker]") {
   // A textured scene seen at night: the image squeezed into grey levels 2..8 with sensor noise on top.
   // The corner detector's threshold is relative, but the noise is not: without equalisation the
   // forward-backward check loses tracks; CLAHE (option `clahe`) stretches the local contrast first.
@@ -456,9 +457,9 @@ TEST_CASE("StereoTracker: CLAHE recovers features in a dark low-contrast image",
   cv::warpAffine(img, moved, shift, img.size(), cv::INTER_LINEAR, cv::BORDER_REFLECT);
 
   auto correctly_tracked = [&](bool clahe) {
-    TrackerOptions opt;
+    tracker::TrackerOptions opt;
     opt.clahe = clahe;
-    StereoTracker tracker(opt, cam);
+    tracker::StereoTracker tracker(opt, cam);
     StereoFrame a, b;
     a.left = dark(img, 1), b.left = dark(moved, 2), b.t_ns = 50'000'000;
     const TrackedFrame fa = tracker.process(a);
@@ -479,10 +480,10 @@ TEST_CASE("StereoTracker: CLAHE recovers features in a dark low-contrast image",
   CHECK(on >= 80);
 }
 
-TEST_CASE("StereoTracker: an image of the wrong size is an error naming the frame time and both sizes", "[tracker]") {
+TEST_CASE("tracker::StereoTracker: an image of the wrong size is an error naming the frame time and both sizes", "[tracker]") {
   PinholeRadtanCamera::Params p;
   p.width = 752, p.height = 480, p.fx = 458, p.fy = 457, p.cx = 367, p.cy = 248;
-  StereoTracker tracker(TrackerOptions{}, std::make_shared<const PinholeRadtanCamera>(p));
+  tracker::StereoTracker tracker(tracker::TrackerOptions{}, std::make_shared<const PinholeRadtanCamera>(p));
   StereoFrame f;
   f.t_ns = 1'403'715'273'262'142'976;
   f.left = cv::Mat(480, 640, CV_8UC1, cv::Scalar(128));

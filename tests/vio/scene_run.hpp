@@ -1,5 +1,5 @@
 #pragma once
-// One simulated scene through the shipped chain (runVioSequential, rate 0: iteration-bound, so the same
+// One simulated scene through the shipped chain (run_vio_sequential, rate 0: iteration-bound, so the same
 // answer on any machine), scored against the simulator's ground truth. Shared by the scene tests.
 #include <cstdint>
 #include <map>
@@ -23,16 +23,16 @@ struct SceneRun {
 inline SceneRun run_scene(const std::shared_ptr<const sim::Scenario>& sc, estimator::BaLoss loss) {
   sim::ScenarioSource src(sc);
   pipeline::VioRunOptions opt;
-  opt.estimator = sim::scenarioEstimatorOptions(*sc);
+  opt.estimator = sim::scenario_estimator_options(*sc);
   opt.mode.loss = loss;
   opt.show_progress = false;
   SceneRun o;
   pipeline::VioSinks sinks;
   sinks.estimate = [&o](const estimator::WindowEstimate& e) { o.run.record(e); };
-  const pipeline::VioRunResult r = pipeline::runVioSequential(src, opt, sinks);
+  const pipeline::VioRunResult r = pipeline::run_vio_sequential(src, opt, sinks);
   REQUIRE(r.report.ok);
-  o.true_speed = pipeline::groundTruthSpeed(r.ground_truth);
-  o.ate = eval::evaluate(pipeline::groundTruthTrajectory(r.ground_truth), o.run.estimate).ate.rmse;
+  o.true_speed = pipeline::ground_truth_speed(r.ground_truth);
+  o.ate = eval::evaluate(pipeline::ground_truth_trajectory(r.ground_truth), o.run.estimate).ate.rmse;
   return o;
 }
 

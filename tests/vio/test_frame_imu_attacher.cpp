@@ -16,14 +16,14 @@ namespace {
 
 constexpr int64_t kMs = 1'000'000;
 
-ImuSample imuAt(int64_t t) {
+ImuSample imu_at(int64_t t) {
   ImuSample s;
   s.t_ns = t;
   s.gyr = Eigen::Vector3d(0.0, 0.0, 1.0);
   return s;
 }
 
-StereoFrame frameAt(int64_t t, int64_t seq) {
+StereoFrame frame_at(int64_t t, int64_t seq) {
   StereoFrame f;
   f.t_ns = t;
   f.seq = seq;
@@ -39,10 +39,10 @@ std::vector<TrackerInput> replay(FrameImuAttacher& a, int64_t end) {
   int64_t next_imu = 0, next_frame = 12 * kMs, seq = 0;
   while (next_imu <= end || next_frame <= end) {
     if (next_frame < next_imu) {
-      take(a.addFrame(frameAt(next_frame, seq++)));
+      take(a.add_frame(frame_at(next_frame, seq++)));
       next_frame += 50 * kMs;
     } else {
-      take(a.addImu(imuAt(next_imu)));
+      take(a.add_imu(imu_at(next_imu)));
       next_imu += 5 * kMs;
     }
   }
@@ -67,9 +67,9 @@ TEST_CASE("FrameImuAttacher packs each frame with the samples of its interval", 
   CHECK(times(out[1].imu) == std::vector<int64_t>{10, 15, 20, 25, 30, 35, 40, 45, 50, 55, 60, 65});
   CHECK(times(out[3].imu).front() == 110);
   CHECK(times(out[3].imu).back() == 165);
-  CHECK(a.releasedIncomplete() == 0);
+  CHECK(a.released_incomplete() == 0);
 
-  const GyroRotationPredictor p(Eigen::Isometry3d::Identity(), 15 * kMs);
+  const tracker::GyroRotationPredictor p(Eigen::Isometry3d::Identity(), 15 * kMs);
   for (std::size_t i = 1; i < out.size(); ++i) {
     const auto R = p.predict(out[i].imu, out[i - 1].frame.t_ns, out[i].frame.t_ns);
     REQUIRE(R);
@@ -79,33 +79,33 @@ TEST_CASE("FrameImuAttacher packs each frame with the samples of its interval", 
 
 TEST_CASE("FrameImuAttacher releases frames on an IMU sample at their exact time", "[vio][gyro]") {
   FrameImuAttacher a;
-  CHECK_FALSE(a.addImu(imuAt(0)));
-  CHECK_FALSE(a.addFrame(frameAt(5 * kMs, 0)));
-  const auto f0 = a.addImu(imuAt(5 * kMs));
+  CHECK_FALSE(a.add_imu(imu_at(0)));
+  CHECK_FALSE(a.add_frame(frame_at(5 * kMs, 0)));
+  const auto f0 = a.add_imu(imu_at(5 * kMs));
   REQUIRE(f0);
   CHECK(times(f0->imu) == std::vector<int64_t>{0, 5});
-  CHECK_FALSE(a.addImu(imuAt(10 * kMs)));
-  CHECK_FALSE(a.addFrame(frameAt(15 * kMs, 1)));
-  const auto f1 = a.addImu(imuAt(15 * kMs));
+  CHECK_FALSE(a.add_imu(imu_at(10 * kMs)));
+  CHECK_FALSE(a.add_frame(frame_at(15 * kMs, 1)));
+  const auto f1 = a.add_imu(imu_at(15 * kMs));
   REQUIRE(f1);
   CHECK(times(f1->imu) == std::vector<int64_t>{5, 10, 15});  // starts exactly at the previous frame
 }
 
 TEST_CASE("FrameImuAttacher hands a frame on without its end sample when the next frame comes first", "[vio][gyro]") {
   FrameImuAttacher a;
-  CHECK_FALSE(a.addImu(imuAt(0)));
-  CHECK_FALSE(a.addFrame(frameAt(2 * kMs, 0)));
-  const auto f0 = a.addFrame(frameAt(4 * kMs, 1));  // no IMU between the two frames
+  CHECK_FALSE(a.add_imu(imu_at(0)));
+  CHECK_FALSE(a.add_frame(frame_at(2 * kMs, 0)));
+  const auto f0 = a.add_frame(frame_at(4 * kMs, 1));  // no IMU between the two frames
   REQUIRE(f0);
   CHECK(f0->frame.seq == 0);
-  CHECK(a.releasedIncomplete() == 1);
+  CHECK(a.released_incomplete() == 1);
   const auto f1 = a.finish();  // end of input
   REQUIRE(f1);
   CHECK(f1->frame.seq == 1);
-  CHECK(a.releasedIncomplete() == 2);
+  CHECK(a.released_incomplete() == 2);
   CHECK_FALSE(a.finish());
   // Neither interval is covered: the predictor refuses rather than extrapolates.
-  const GyroRotationPredictor p(Eigen::Isometry3d::Identity(), 15 * kMs);
+  const tracker::GyroRotationPredictor p(Eigen::Isometry3d::Identity(), 15 * kMs);
   CHECK_FALSE(p.predict(f1->imu, 2 * kMs, 4 * kMs));
 }
 
@@ -114,16 +114,16 @@ TEST_CASE("a frame dropped after the attacher leaves the next one without predic
   auto out = replay(a, 200 * kMs);
   REQUIRE(out.size() == 4);
   out.erase(out.begin() + 1);  // the frame queue dropped the frame at 62 ms
-  const GyroRotationPredictor p(Eigen::Isometry3d::Identity(), 15 * kMs);
+  const tracker::GyroRotationPredictor p(Eigen::Isometry3d::Identity(), 15 * kMs);
   CHECK_FALSE(p.predict(out[1].imu, out[0].frame.t_ns, out[1].frame.t_ns));  // 12 -> 112 ms: samples start at 60
   CHECK(p.predict(out[2].imu, out[1].frame.t_ns, out[2].frame.t_ns));         // 112 -> 162 ms: covered again
 }
 
 TEST_CASE("FrameImuAttacher keeps a bounded buffer while no frame comes", "[vio][gyro]") {
   FrameImuAttacher a(10);
-  for (int i = 0; i < 100; ++i) CHECK_FALSE(a.addImu(imuAt(i * 5 * kMs)));
-  CHECK_FALSE(a.addFrame(frameAt(600 * kMs, 0)));
-  const auto f = a.addImu(imuAt(600 * kMs));
+  for (int i = 0; i < 100; ++i) CHECK_FALSE(a.add_imu(imu_at(i * 5 * kMs)));
+  CHECK_FALSE(a.add_frame(frame_at(600 * kMs, 0)));
+  const auto f = a.add_imu(imu_at(600 * kMs));
   REQUIRE(f);
   CHECK(f->imu.size() == 11);
   CHECK(f->imu.front().t_ns == 450 * kMs);

@@ -37,10 +37,10 @@ TEST_CASE("override: --set key=value overrides the yaml and is printed as (--set
 }
 
 TEST_CASE("override: --set rejects malformed text, unknown keys, bad values and rig keys, naming the key", "[vio][options]") {
-  CHECK(EstimatorOptions::parseOverride(" max_cnt = 120 ") == std::make_pair(std::string("max_cnt"), std::string("120")));
-  CHECK_THROWS_WITH(EstimatorOptions::parseOverride("max_cnt"), Contains("--set") && Contains("key=value"));
-  CHECK_THROWS_WITH(EstimatorOptions::parseOverride("=3"), Contains("--set") && Contains("empty key"));
-  CHECK_THROWS_WITH(EstimatorOptions::parseOverride("max_cnt="), Contains("--set") && Contains("'max_cnt'"));
+  CHECK(EstimatorOptions::parse_override(" max_cnt = 120 ") == std::make_pair(std::string("max_cnt"), std::string("120")));
+  CHECK_THROWS_WITH(EstimatorOptions::parse_override("max_cnt"), Contains("--set") && Contains("key=value"));
+  CHECK_THROWS_WITH(EstimatorOptions::parse_override("=3"), Contains("--set") && Contains("empty key"));
+  CHECK_THROWS_WITH(EstimatorOptions::parse_override("max_cnt="), Contains("--set") && Contains("'max_cnt'"));
 
   EstimatorOptions o = EstimatorOptions::load(kStereo);
   CHECK_THROWS_AS(o.apply("max_cnt", "12x"), ConfigError);
@@ -60,21 +60,21 @@ TEST_CASE("a missing config names the file", "[vio][options]") {
   CHECK_THROWS_WITH(EstimatorOptions::load(missing, {{"max_cnt", "100"}}), Contains(missing));
 }
 
-TEST_CASE("runVio refuses options it cannot run before starting any thread", "[vio][options]") {
+TEST_CASE("run_vio refuses options it cannot run before starting any thread", "[vio][options]") {
   auto source = io::EurocSource(std::make_shared<io::EurocDataset>(std::string(DYNAVINS_SHARED_DIR) +
                                                                    "/data/euroc_v1_01_micro"));
   pipeline::VioRunOptions o;
   o.show_progress = false;
   o.estimator = EstimatorOptions::load(kConfigDir + "euroc_mono_imu_config.yaml");
   o.mode.stereo = true;
-  CHECK_THROWS_WITH(pipeline::runVio(source, o, {}), Contains("--mono"));
+  CHECK_THROWS_WITH(pipeline::run_vio(source, o, {}), Contains("--mono"));
   o.mode.stereo = false;
   o.rate = -1;
-  CHECK_THROWS_WITH(pipeline::runVio(source, o, {}), Contains("rate"));
+  CHECK_THROWS_WITH(pipeline::run_vio(source, o, {}), Contains("rate"));
 }
 
 TEST_CASE("TUM time stamps are exact seconds with 9 decimals", "[vio][options]") {
-  CHECK(pipeline::formatSeconds(1403715273262142976) == "1403715273.262142976");
-  CHECK(pipeline::formatSeconds(5) == "0.000000005");
-  CHECK(pipeline::formatSeconds(-1'500'000'000) == "-1.500000000");
+  CHECK(pipeline::format_seconds(1403715273262142976) == "1403715273.262142976");
+  CHECK(pipeline::format_seconds(5) == "0.000000005");
+  CHECK(pipeline::format_seconds(-1'500'000'000) == "-1.500000000");
 }

@@ -18,13 +18,13 @@ namespace fs = std::filesystem;
 
 namespace {
 
-std::string freshDir(const std::string& name) {
+std::string fresh_dir(const std::string& name) {
   const fs::path d = fs::temp_directory_path() / ("dynavins_test_outputs_" + name + "_" + std::to_string(::getpid()));
   fs::remove_all(d);
   return d.string();
 }
 
-GroundTruthState truthAt(int k) {
+GroundTruthState truth_at(int k) {
   GroundTruthState g;
   g.t_ns = 1'000'000'000 + k * 50'000'000LL;
   const double t = 0.05 * k;
@@ -36,20 +36,20 @@ GroundTruthState truthAt(int k) {
 }  // namespace
 
 TEST_CASE("RunOutputs writes ground truth and an SE3 ATE of zero for a rigidly moved copy", "[vio][outputs]") {
-  const std::string dir = freshDir("ate");
+  const std::string dir = fresh_dir("ate");
   RunOutputs out(dir);
   VioRunResult run;
   run.report.ok = true;
   const Eigen::Quaterniond R(Eigen::AngleAxisd(1.0, Eigen::Vector3d::UnitZ()));
   const Eigen::Vector3d t(3, -2, 1);
   for (int k = 0; k < 40; ++k) {
-    run.ground_truth.push_back(truthAt(k));
+    run.ground_truth.push_back(truth_at(k));
     estimator::WindowEstimate e;
-    e.t_ns = truthAt(k).t_ns;
+    e.t_ns = truth_at(k).t_ns;
     e.seq = k;
     e.status = k < 5 ? estimator::EstimatorStatus::Initializing : estimator::EstimatorStatus::Tracking;
-    e.state.p_wb = R * truthAt(k).p_wb + t;
-    e.state.q_wb = R * truthAt(k).q_wb;
+    e.state.p_wb = R * truth_at(k).p_wb + t;
+    e.state.q_wb = R * truth_at(k).q_wb;
     e.solve.alternations = k < 5 ? 0 : 2;
     e.solve.ba_ms = k;
     if (k == 5) e.event = "initialized, \"quoted\"";
@@ -67,8 +67,8 @@ TEST_CASE("RunOutputs writes ground truth and an SE3 ATE of zero for a rigidly m
   CHECK(gt.size() == 40);
   const eval::Trajectory est = eval::read_trajectory(dir + "/odometry.tum");
   REQUIRE(est.size() == 35);
-  CHECK(est.poses[0].t_ns == truthAt(5).t_ns);
-  const std::string j = out.summaryJson();
+  CHECK(est.poses[0].t_ns == truth_at(5).t_ns);
+  const std::string j = out.summary_json();
   CHECK(j.find("\"ate_se3_m\": ") != std::string::npos);
   CHECK(j.find("\"ba_solves\": 35,") != std::string::npos);
   CHECK(j.find("\"ba_ms_max\": 39,") != std::string::npos);
@@ -79,13 +79,13 @@ TEST_CASE("RunOutputs writes ground truth and an SE3 ATE of zero for a rigidly m
   std::string header, line;
   std::getline(ev, header);
   std::getline(ev, line);
-  CHECK(line == std::to_string(truthAt(5).t_ns) + ",5,\"initialized, \"\"quoted\"\"\"");
+  CHECK(line == std::to_string(truth_at(5).t_ns) + ",5,\"initialized, \"\"quoted\"\"\"");
   for (const auto& f : fs::directory_iterator(dir)) CHECK(f.path().extension() != ".partial");
   fs::remove_all(dir);
 }
 
 TEST_CASE("RunOutputs removes an earlier run's results so a failed run leaves nothing final", "[vio][outputs]") {
-  const std::string dir = freshDir("stale");
+  const std::string dir = fresh_dir("stale");
   fs::create_directories(dir);
   std::ofstream(dir + "/summary.json") << "{}\n";
   std::ofstream(dir + "/odometry.tum") << "1 0 0 0 0 0 0 1\n";
@@ -102,7 +102,7 @@ TEST_CASE("RunOutputs removes an earlier run's results so a failed run leaves no
 }
 
 TEST_CASE("RunOutputs names the directory it cannot create", "[vio][outputs]") {
-  const std::string file = freshDir("file");
+  const std::string file = fresh_dir("file");
   std::ofstream(file) << "x";
   CHECK_THROWS_WITH(RunOutputs(file + "/sub"), Catch::Contains(file));
   fs::remove(file);

@@ -9,10 +9,10 @@
 
 using namespace dynavins;
 
-TEST_CASE("StereoTracker fills sim_label from the label image at the rounded left pixel", "[vio][tracker]") {
+TEST_CASE("tracker::StereoTracker fills sim_label from the label image at the rounded left pixel", "[vio][tracker]") {
   const auto o = EstimatorOptions::load(std::string(DYNAVINS_SHARED_DIR) +
                                         "/data/vins_fusion_euroc_config/euroc_stereo_imu_config.yaml");
-  StereoTracker tracker(TrackerOptions::from(o), o.cameras[0]);
+  tracker::StereoTracker tracker(tracker::TrackerOptions::from(o), o.cameras[0]);
   cv::Mat img(o.image_height, o.image_width, CV_8U);
   cv::RNG rng(7);
   rng.fill(img, cv::RNG::UNIFORM, 0, 255);

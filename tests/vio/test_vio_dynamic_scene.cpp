@@ -1,5 +1,5 @@
 // A short deterministic scene where a truck crossing 5 m ahead fills most of the image for about two
-// seconds (tests/data/scenarios/truck_crossing.yaml), through the shipped chain (runVioSequential, rate 0:
+// seconds (tests/data/scenarios/truck_crossing.yaml), through the shipped chain (run_vio_sequential, rate 0:
 // iteration-bound, so the same answer on any machine): the DynaVINS weights keep the pose within an honest
 // bound of the simulator's ground truth, while the Huber baseline (VINS-Fusion's loss) does not.
 // Measured when written: dynavins ATE 0.12 m, no reset, 98.9% of truck features rejected;
@@ -19,7 +19,7 @@ constexpr double kAteBound = 0.3;  // metres over a 12 s, ~35 m flight
 
 using Outcome = test::SceneRun;
 
-Outcome runScene(const std::shared_ptr<const sim::Scenario>& sc, estimator::BaLoss loss) {
+Outcome run_scene(const std::shared_ptr<const sim::Scenario>& sc, estimator::BaLoss loss) {
   return test::run_scene(sc, loss);
 }
 }  // namespace
@@ -28,12 +28,12 @@ TEST_CASE("truck crossing ahead: dynavins holds where huber does not", "[vio][dy
   const auto sc = sim::build_scenario(
       sim::load_scenario(std::string(DYNAVINS_SOURCE_DIR) + "/tests/data/scenarios/truck_crossing.yaml"));
 
-  const Outcome dyn = runScene(sc, estimator::BaLoss::Dynavins);
+  const Outcome dyn = run_scene(sc, estimator::BaLoss::Dynavins);
   INFO("dynavins ATE " << dyn.ate << " m, resets " << dyn.run.resets);
   CHECK(dyn.run.resets == 0);
   CHECK(dyn.run.tracking_frames >= 0.9 * dyn.run.frames);
   CHECK(dyn.ate < kAteBound);
-  const eval::WeightScore score = eval::scoreWeights(dyn.run.features);
+  const eval::WeightScore score = eval::score_weights(dyn.run.features);
   REQUIRE(score.moving > 50);  // the truck was seen and its features went through the BA
   CHECK(score.moving_rejected >= 0.9);
   // The standstill detector (zero-velocity factor) never held a moving camera: at every frame it found at
@@ -46,7 +46,7 @@ TEST_CASE("truck crossing ahead: dynavins holds where huber does not", "[vio][dy
     CHECK(it->second < 0.2);
   }
 
-  const Outcome hub = runScene(sc, estimator::BaLoss::Huber);
+  const Outcome hub = run_scene(sc, estimator::BaLoss::Huber);
   INFO("huber ATE " << hub.ate << " m, resets " << hub.run.resets);
   // The baseline either loses the pose (a reset restarts it from the origin) or drifts past the bound.
   CHECK((hub.run.resets > 0 || hub.ate > kAteBound));

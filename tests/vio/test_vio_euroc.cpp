@@ -1,6 +1,6 @@
 // The shipped chain on real data: VINS-Fusion's own EuRoC stereo-inertial config, unchanged, on the EuRoC
 // V1_01 clip in ../shared, where the sensor stands still. It must initialise from standstill and stay put.
-// runVioSequential: the stages of `dynavins run`, one after the other, iteration-bound (rate 0).
+// run_vio_sequential: the stages of `dynavins run`, one after the other, iteration-bound (rate 0).
 #include "tests/estimator/catch_with_ceres.hpp"
 
 #include <filesystem>
@@ -15,7 +15,7 @@ using namespace dynavins;
 namespace {
 const std::string kShared = DYNAVINS_SHARED_DIR;
 
-double maxDistanceFromStart(const eval::Trajectory& t) {
+double max_distance_from_start(const eval::Trajectory& t) {
   double d = 0;
   for (const auto& p : t.poses) d = std::max(d, (p.p - t.poses.front().p).norm());
   return d;
@@ -31,20 +31,20 @@ TEST_CASE("EuRoC clip with VINS-Fusion's stereo-imu config: initialises at stand
   opt.estimator = EstimatorOptions::load(config);
   opt.show_progress = false;
   for (auto loss : {estimator::BaLoss::Huber, estimator::BaLoss::Dynavins}) {
-    INFO("BA " << estimator::toString(loss));
+    INFO("BA " << estimator::to_string(loss));
     io::EurocSource src(std::make_shared<io::EurocDataset>(clip));
     opt.mode.loss = loss;
     pipeline::EstimateRecorder r;
     pipeline::VioSinks sinks;
     sinks.estimate = [&r](const estimator::WindowEstimate& e) { r.record(e); };
-    const pipeline::VioRunResult run = pipeline::runVioSequential(src, opt, sinks);
+    const pipeline::VioRunResult run = pipeline::run_vio_sequential(src, opt, sinks);
     REQUIRE(run.report.ok);
     CHECK_FALSE(run.solver_time_budget);
     CHECK(r.resets == 0);
     // 11 frames fill the window; every frame after that is tracked.
     CHECK(r.tracking_frames >= r.frames - opt.estimator.window_size - 1);
     REQUIRE(r.tracking_frames > 50);
-    CHECK(maxDistanceFromStart(r.estimate) < 0.05);
+    CHECK(max_distance_from_start(r.estimate) < 0.05);
     // The sensor never moves: after the first tracked frame, the standstill detector finds it at rest.
     CHECK(r.standstill_t_ns.size() >= 0.9 * (r.tracking_frames - 1));
   }

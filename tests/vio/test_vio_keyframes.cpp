@@ -1,5 +1,5 @@
 // The estimator's finished keyframes (WindowEstimate::finished_keyframes, the loop closer's input) through
-// the shipped chain (runVioSequential, rate 0: deterministic) on a short moving simulator scene: the first
+// the shipped chain (run_vio_sequential, rate 0: deterministic) on a short moving simulator scene: the first
 // 6 s of tests/data/scenarios/truck_crossing.yaml without its truck (a drone flying along a street).
 // Checks that keyframes leave the window once each, in time order, only frames the window kept, with
 // poses close to the simulator's ground truth, triangulated weighted points and the left image.
@@ -28,7 +28,7 @@ TEST_CASE("finished keyframes of a moving scene: once each, in order, kept frame
   const auto sc = sim::build_scenario(spec);
   sim::ScenarioSource src(sc);
   pipeline::VioRunOptions opt;
-  opt.estimator = sim::scenarioEstimatorOptions(*sc);
+  opt.estimator = sim::scenario_estimator_options(*sc);
   opt.show_progress = false;
 
   std::vector<estimator::WindowEstimate> estimates;
@@ -43,7 +43,7 @@ TEST_CASE("finished keyframes of a moving scene: once each, in order, kept frame
     estimates.push_back(std::move(light));
   };
   sinks.keyframe = [&](const Keyframe& kf) { keyframes.push_back(kf); };
-  const pipeline::VioRunResult r = pipeline::runVioSequential(src, opt, sinks);
+  const pipeline::VioRunResult r = pipeline::run_vio_sequential(src, opt, sinks);
   REQUIRE(r.report.ok);
   REQUIRE(r.resets == 0);
   REQUIRE(keyframes.size() >= 10);
@@ -66,10 +66,10 @@ TEST_CASE("finished keyframes of a moving scene: once each, in order, kept frame
 
   // Poses: the window's final estimate of each keyframe, against the truth, in the frame the per-frame
   // odometry aligns to (SE(3) Umeyama over all frames: the keyframes alone lie too close to a line).
-  const eval::Trajectory gt = pipeline::groundTruthTrajectory(r.ground_truth);
+  const eval::Trajectory gt = pipeline::ground_truth_trajectory(r.ground_truth);
   const eval::EvalResult odo = eval::evaluate(gt, recorder.estimate);
   eval::Trajectory kf_traj;
-  for (const Keyframe& kf : keyframes) kf_traj.poses.push_back(eval::stampedPose(kf.t_ns, kf.p_wb, kf.q_wb));
+  for (const Keyframe& kf : keyframes) kf_traj.poses.push_back(eval::stamped_pose(kf.t_ns, kf.p_wb, kf.q_wb));
   const eval::Trajectory kf_aligned = eval::transformed(kf_traj, odo.alignment);
   double sq = 0, worst = 0;
   for (const eval::StampedPose& k : kf_aligned.poses) {

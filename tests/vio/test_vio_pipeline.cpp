@@ -1,4 +1,4 @@
-// runVio on the real EuRoC clip (95 stereo frames, 4.7 s): completes losslessly at full speed, accounts
+// run_vio on the real EuRoC clip (95 stereo frames, 4.7 s): completes losslessly at full speed, accounts
 // for every frame when paced, writes well-formed outputs, seeds the tracker with the gyro (or not, when
 // asked), and stops cleanly on a stop request or SIGINT.
 #include <algorithm>
@@ -29,7 +29,7 @@ const std::string kClip = std::string(DYNAVINS_SHARED_DIR) + "/data/euroc_v1_01_
 const std::string kConfig = std::string(DYNAVINS_SHARED_DIR) + "/data/vins_fusion_euroc_config/euroc_stereo_imu_config.yaml";
 constexpr int64_t kClipFrames = 95;
 
-VioRunOptions clipOptions(double rate = 0.0, bool gyro_prediction = true) {
+VioRunOptions clip_options(double rate = 0.0, bool gyro_prediction = true) {
   VioRunOptions o;
   o.estimator = EstimatorOptions::load(kConfig);
   o.rate = rate;
@@ -42,13 +42,13 @@ std::unique_ptr<io::SensorSource> clip() {
   return std::make_unique<io::EurocSource>(std::make_shared<io::EurocDataset>(kClip));
 }
 
-std::string freshDir(const std::string& name) {
+std::string fresh_dir(const std::string& name) {
   const fs::path d = fs::temp_directory_path() / ("dynavins_test_vio_" + name + "_" + std::to_string(::getpid()));
   fs::remove_all(d);
   return d.string();
 }
 
-std::vector<std::string> dataLines(const std::string& path) {
+std::vector<std::string> data_lines(const std::string& path) {
   std::ifstream f(path);
   REQUIRE(f.good());
   std::vector<std::string> lines;
@@ -70,7 +70,7 @@ struct RunWithOutputs {
 };
 
 // Runs the clip into `dir`; `on_estimate(n)` is called on the writer thread after the n-th estimate.
-RunWithOutputs runClip(const std::string& dir, double rate, const StopFlag* stop = nullptr,
+RunWithOutputs run_clip(const std::string& dir, double rate, const StopFlag* stop = nullptr,
                        std::function<void(int)> on_estimate = {}, bool gyro_prediction = true) {
   RunWithOutputs r;
   r.outputs = std::make_unique<RunOutputs>(dir);
@@ -81,13 +81,13 @@ RunWithOutputs runClip(const std::string& dir, double rate, const StopFlag* stop
     if (on_estimate) on_estimate(++n);
   };
   auto source = clip();
-  r.result = runVio(*source, clipOptions(rate, gyro_prediction), sinks, stop);
+  r.result = run_vio(*source, clip_options(rate, gyro_prediction), sinks, stop);
   RunDescription what{kConfig, "euroc:" + kClip, "dynavins", true, rate};
   if (r.result.report.ok) r.outputs->complete(r.result, what);
   return r;
 }
 
-void checkFrameAccounting(const VioRunResult& r) {
+void check_frame_accounting(const VioRunResult& r) {
   CHECK(r.replay.frames == r.frames_tracked + r.frames_dropped);
   CHECK(r.frames_tracked == r.frames_estimated + r.pairer.unpaired_at_finish + r.pairer.skipped_inside_interval +
                                 r.pairer.frames_out_of_order);
@@ -95,13 +95,13 @@ void checkFrameAccounting(const VioRunResult& r) {
   if (r.gyro_prediction) CHECK(r.frames_gyro_predicted + r.frames_gyro_unpredicted == r.frames_tracked);
 }
 
-void checkOutputsWellFormed(const std::string& dir, const RunOutputs& out) {
+void check_outputs_well_formed(const std::string& dir, const RunOutputs& out) {
   for (const char* name : {"odometry.tum", "features.csv", "estimator_events.csv", "summary.json"}) {
     INFO(name);
     CHECK(fs::exists(fs::path(dir) / name));
     CHECK_FALSE(fs::exists(fs::path(dir) / (std::string(name) + ".partial")));
   }
-  const auto odo = dataLines(dir + "/odometry.tum");
+  const auto odo = data_lines(dir + "/odometry.tum");
   CHECK(static_cast<int64_t>(odo.size()) == out.totals().tracking);
   for (const auto& l : odo) {
     std::istringstream in(l);
@@ -109,7 +109,7 @@ void checkOutputsWellFormed(const std::string& dir, const RunOutputs& out) {
     for (double& x : v) REQUIRE(static_cast<bool>(in >> x));
     CHECK(std::abs(Eigen::Vector4d(v[4], v[5], v[6], v[7]).norm() - 1.0) < 1e-6);
   }
-  const auto feats = dataLines(dir + "/features.csv");
+  const auto feats = data_lines(dir + "/features.csv");
   REQUIRE_FALSE(feats.empty());
   CHECK(feats[0] == "t_ns,seq,feature_id,u,v,weight,times_solved,sim_label,x,y,z,u_r,v_r");
   CHECK(static_cast<int64_t>(feats.size()) - 1 == out.totals().feature_rows);
@@ -132,7 +132,7 @@ void checkOutputsWellFormed(const std::string& dir, const RunOutputs& out) {
     std::nth_element(disparity.begin(), disparity.begin() + disparity.size() / 2, disparity.end());
     CHECK(disparity[disparity.size() / 2] > 1.0);
   }
-  const auto events = dataLines(dir + "/estimator_events.csv");
+  const auto events = data_lines(dir + "/estimator_events.csv");
   REQUIRE_FALSE(events.empty());
   CHECK(events[0] == "t_ns,seq,event");
   CHECK(static_cast<int64_t>(events.size()) - 1 == out.totals().events);
@@ -142,14 +142,14 @@ void checkOutputsWellFormed(const std::string& dir, const RunOutputs& out) {
   CHECK(json.find("\"frames_estimated\": " + std::to_string(out.totals().estimates) + ",") != std::string::npos);
   CHECK(json.find("\"peak_rss_mb\": ") != std::string::npos);
   CHECK(json.find("\"stage_ms\": {\"replay\"") != std::string::npos);
-  CHECK(json == out.summaryJson() + "\n");
+  CHECK(json == out.summary_json() + "\n");
 }
 
 }  // namespace
 
-TEST_CASE("runVio at full speed processes every frame of the EuRoC clip, losslessly", "[vio]") {
-  const std::string dir = freshDir("full");
-  RunWithOutputs r = runClip(dir, 0.0);
+TEST_CASE("run_vio at full speed processes every frame of the EuRoC clip, losslessly", "[vio]") {
+  const std::string dir = fresh_dir("full");
+  RunWithOutputs r = run_clip(dir, 0.0);
   const VioRunResult& res = r.result;
   INFO(res.report.error);
   REQUIRE(res.report.ok);
@@ -163,9 +163,9 @@ TEST_CASE("runVio at full speed processes every frame of the EuRoC clip, lossles
   CHECK(res.imu.intervals == kClipFrames - 1);
   CHECK(res.imu.imu_samples == res.replay.imu);
   CHECK(r.outputs->totals().estimates == kClipFrames);
-  checkFrameAccounting(res);
-  checkOutputsWellFormed(dir, *r.outputs);
-  const std::string json = r.outputs->summaryJson();
+  check_frame_accounting(res);
+  check_outputs_well_formed(dir, *r.outputs);
+  const std::string json = r.outputs->summary_json();
   CHECK(json.find("\"frames_in\": 95,") != std::string::npos);
   CHECK(json.find("\"frames_dropped\": 0,") != std::string::npos);
   CHECK(json.find("\"interrupted\": false,") != std::string::npos);
@@ -179,9 +179,9 @@ TEST_CASE("runVio at full speed processes every frame of the EuRoC clip, lossles
   fs::remove_all(dir);
 }
 
-TEST_CASE("runVio with gyro prediction off tracks every frame unseeded", "[vio]") {
-  const std::string dir = freshDir("nogyro");
-  RunWithOutputs r = runClip(dir, 0.0, nullptr, {}, /*gyro_prediction=*/false);
+TEST_CASE("run_vio with gyro prediction off tracks every frame unseeded", "[vio]") {
+  const std::string dir = fresh_dir("nogyro");
+  RunWithOutputs r = run_clip(dir, 0.0, nullptr, {}, /*gyro_prediction=*/false);
   const VioRunResult& res = r.result;
   INFO(res.report.error);
   REQUIRE(res.report.ok);
@@ -191,29 +191,29 @@ TEST_CASE("runVio with gyro prediction off tracks every frame unseeded", "[vio]"
   CHECK(res.frames_gyro_unpredicted == 0);
   CHECK(res.features_gyro_predicted == 0);
   CHECK(res.features_tracked > 0);
-  checkFrameAccounting(res);
-  CHECK(r.outputs->summaryJson().find("\"tracker\": {\"gyro_prediction\": false,") != std::string::npos);
+  check_frame_accounting(res);
+  CHECK(r.outputs->summary_json().find("\"tracker\": {\"gyro_prediction\": false,") != std::string::npos);
   fs::remove_all(dir);
 }
 
-TEST_CASE("runVio paced in real time accounts for every frame, dropped ones included", "[vio]") {
-  const std::string dir = freshDir("paced");
-  RunWithOutputs r = runClip(dir, 4.0);
+TEST_CASE("run_vio paced in real time accounts for every frame, dropped ones included", "[vio]") {
+  const std::string dir = fresh_dir("paced");
+  RunWithOutputs r = run_clip(dir, 4.0);
   INFO(r.result.report.error);
   REQUIRE(r.result.report.ok);
   CHECK(r.result.replay.frames == kClipFrames);
-  checkFrameAccounting(r.result);
+  check_frame_accounting(r.result);
   CHECK(r.result.frames_estimated >= 1);
   // A frame after a dropped one has no IMU back to the tracker's previous frame: no prediction.
   CHECK(r.result.frames_gyro_unpredicted >= 1 + (r.result.frames_dropped > 0 ? 1 : 0));
-  checkOutputsWellFormed(dir, *r.outputs);
+  check_outputs_well_formed(dir, *r.outputs);
   fs::remove_all(dir);
 }
 
 TEST_CASE("a stop request mid-run drains the queues and marks the run interrupted", "[vio]") {
-  const std::string dir = freshDir("stop");
+  const std::string dir = fresh_dir("stop");
   StopFlag stop;
-  RunWithOutputs r = runClip(dir, 0.0, &stop, [&](int n) {
+  RunWithOutputs r = run_clip(dir, 0.0, &stop, [&](int n) {
     if (n == 20) stop.request_stop();
   });
   INFO(r.result.report.error);
@@ -221,17 +221,17 @@ TEST_CASE("a stop request mid-run drains the queues and marks the run interrupte
   CHECK(r.result.interrupted());
   CHECK(r.result.frames_estimated >= 20);
   CHECK(r.result.replay.frames < kClipFrames);
-  checkFrameAccounting(r.result);
-  checkOutputsWellFormed(dir, *r.outputs);
-  CHECK(r.outputs->summaryJson().find("\"interrupted\": true,") != std::string::npos);
+  check_frame_accounting(r.result);
+  check_outputs_well_formed(dir, *r.outputs);
+  CHECK(r.outputs->summary_json().find("\"interrupted\": true,") != std::string::npos);
   fs::remove_all(dir);
 }
 
 TEST_CASE("SIGINT mid-run stops the replay cleanly", "[vio]") {
-  const std::string dir = freshDir("sigint");
+  const std::string dir = fresh_dir("sigint");
   install_interrupt_handler();
   clear_interrupt();
-  RunWithOutputs r = runClip(dir, 0.0, nullptr, [](int n) {
+  RunWithOutputs r = run_clip(dir, 0.0, nullptr, [](int n) {
     if (n == 10) std::raise(SIGINT);
   });
   clear_interrupt();
@@ -239,13 +239,13 @@ TEST_CASE("SIGINT mid-run stops the replay cleanly", "[vio]") {
   REQUIRE(r.result.report.ok);
   CHECK(r.result.interrupted());
   CHECK(r.result.replay.frames < kClipFrames);
-  checkFrameAccounting(r.result);
-  checkOutputsWellFormed(dir, *r.outputs);
+  check_frame_accounting(r.result);
+  check_outputs_well_formed(dir, *r.outputs);
   fs::remove_all(dir);
 }
 
 TEST_CASE("odometry has one line per frame once the estimator tracks", "[vio]") {
-  const std::string dir = freshDir("odometry");
+  const std::string dir = fresh_dir("odometry");
   int64_t first_tracking = -1, n = 0, tracking_after = 0;
   RunOutputs outputs(dir);
   VioSinks sinks;
@@ -257,12 +257,12 @@ TEST_CASE("odometry has one line per frame once the estimator tracks", "[vio]") 
     ++n;
   };
   auto source = clip();
-  const VioRunResult r = runVio(*source, clipOptions(), sinks);
+  const VioRunResult r = run_vio(*source, clip_options(), sinks);
   REQUIRE(r.report.ok);
   outputs.complete(r, RunDescription{kConfig, kClip, "dynavins", true, 0.0});
   REQUIRE(first_tracking >= 0);
   CHECK(first_tracking < 30);  // a standing start initialises within the first 1.5 s
   CHECK(tracking_after == n - first_tracking);
-  CHECK(static_cast<int64_t>(dataLines(dir + "/odometry.tum").size()) == n - first_tracking);
+  CHECK(static_cast<int64_t>(data_lines(dir + "/odometry.tum").size()) == n - first_tracking);
   fs::remove_all(dir);
 }

@@ -1,4 +1,4 @@
-// runVioSequential is the threaded run without its threads: at rate 0 (every queue blocks, solves bounded by
+// run_vio_sequential is the threaded run without its threads: at rate 0 (every queue blocks, solves bounded by
 // their iteration budget alone) both must give the same estimates bit for bit, on the real EuRoC clip.
 #include <catch2/catch.hpp>
 
@@ -27,7 +27,7 @@ struct Estimate {
 
 using Driver = VioRunResult (*)(io::SensorSource&, const VioRunOptions&, const VioSinks&, const StopFlag*);
 
-std::vector<Estimate> runClip(Driver drive, estimator::BaLoss loss, bool stereo) {
+std::vector<Estimate> run_clip(Driver drive, estimator::BaLoss loss, bool stereo) {
   VioRunOptions o;
   o.estimator = EstimatorOptions::load(kConfig);
   o.mode.loss = loss;
@@ -48,7 +48,7 @@ std::vector<Estimate> runClip(Driver drive, estimator::BaLoss loss, bool stereo)
   return out;
 }
 
-void requireIdentical(const std::vector<Estimate>& a, const std::vector<Estimate>& b) {
+void require_identical(const std::vector<Estimate>& a, const std::vector<Estimate>& b) {
   REQUIRE(a.size() == b.size());
   int tracking = 0;
   for (std::size_t i = 0; i < a.size(); ++i) {
@@ -69,14 +69,14 @@ void requireIdentical(const std::vector<Estimate>& a, const std::vector<Estimate
 
 TEST_CASE("sequential and threaded rate-0 runs give the same estimates bit for bit", "[vio][sequential]") {
   // Stereo only: the clip stands still, so a mono run never initialises on it (no parallax).
-  requireIdentical(runClip(&runVio, estimator::BaLoss::Dynavins, true),
-                   runClip(&runVioSequential, estimator::BaLoss::Dynavins, true));
+  require_identical(run_clip(&run_vio, estimator::BaLoss::Dynavins, true),
+                   run_clip(&run_vio_sequential, estimator::BaLoss::Dynavins, true));
 }
 
-TEST_CASE("runVioSequential refuses a paced rate", "[vio][sequential]") {
+TEST_CASE("run_vio_sequential refuses a paced rate", "[vio][sequential]") {
   VioRunOptions o;
   o.estimator = EstimatorOptions::load(kConfig);
   o.rate = 1.0;
   io::EurocSource src(std::make_shared<io::EurocDataset>(kClip));
-  CHECK_THROWS_AS(runVioSequential(src, o, {}, nullptr), std::invalid_argument);
+  CHECK_THROWS_AS(run_vio_sequential(src, o, {}, nullptr), std::invalid_argument);
 }

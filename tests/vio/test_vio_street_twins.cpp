@@ -1,6 +1,6 @@
 // A crowded street and its static twin (tests/data/scenarios/street_crowd_short.yaml and
 // street_static_short.yaml: the same world, noise seed and 12 s path at 3 m/s; issue 23), through the
-// shipped chain (runVioSequential, rate 0: iteration-bound, so the same answer on any machine).
+// shipped chain (run_vio_sequential, rate 0: iteration-bound, so the same answer on any machine).
 // What it checks: where nothing moves, few static features rejected and dynavins' ATE within a bound of
 // Huber's (the issue's goal, no cost at all, is not reached yet: README, "Street scenes"); in the crowd,
 // the moving features rejected, an ATE close to its own static twin's and far below Huber's. The bounds
@@ -32,7 +32,7 @@ constexpr double kHuberRatio = 0.2;          // crowd: dynavins ATE <= this x hu
 
 using Outcome = test::SceneRun;
 
-Outcome runScene(const std::shared_ptr<const sim::Scenario>& sc, estimator::BaLoss loss) {
+Outcome run_scene(const std::shared_ptr<const sim::Scenario>& sc, estimator::BaLoss loss) {
   return test::run_scene(sc, loss);
 }
 
@@ -46,27 +46,27 @@ std::shared_ptr<const sim::Scenario> scene(const std::string& name) {
 TEST_CASE("street twins: the robust BA keeps the static street and holds in the crowd",
           "[vio][dynamic][street]") {
   const auto still = scene("street_static_short");
-  const Outcome dyn_still = runScene(still, estimator::BaLoss::Dynavins);
-  const Outcome hub_still = runScene(still, estimator::BaLoss::Huber);
+  const Outcome dyn_still = run_scene(still, estimator::BaLoss::Dynavins);
+  const Outcome hub_still = run_scene(still, estimator::BaLoss::Huber);
   INFO("static twin: dynavins ATE " << dyn_still.ate << " m, huber " << hub_still.ate << " m");
   REQUIRE(dyn_still.run.resets == 0);
   REQUIRE(hub_still.run.resets == 0);
   CHECK(dyn_still.run.tracking_frames >= 0.9 * dyn_still.run.frames);
   // No cost when nothing moves: within Huber's ATE (with the margin of one noise draw).
   CHECK(dyn_still.ate <= kStillMargin * hub_still.ate);
-  const eval::WeightScore still_score = eval::scoreWeights(dyn_still.run.features);
-  REQUIRE(still_score.static_ > 100);
+  const eval::WeightScore still_score = eval::score_weights(dyn_still.run.features);
+  REQUIRE(still_score.stationary > 100);
   CHECK(still_score.moving == 0);
   CHECK(1.0 - still_score.static_kept < kMaxStaticRejected);
 
   const auto crowd = scene("street_crowd_short");
-  const Outcome dyn_crowd = runScene(crowd, estimator::BaLoss::Dynavins);
-  const Outcome hub_crowd = runScene(crowd, estimator::BaLoss::Huber);
+  const Outcome dyn_crowd = run_scene(crowd, estimator::BaLoss::Dynavins);
+  const Outcome hub_crowd = run_scene(crowd, estimator::BaLoss::Huber);
   INFO("crowd: dynavins ATE " << dyn_crowd.ate << " m (resets " << dyn_crowd.run.resets << "), huber "
                               << hub_crowd.ate << " m (resets " << hub_crowd.run.resets << ")");
   CHECK(dyn_crowd.run.resets == 0);
   CHECK(dyn_crowd.run.tracking_frames >= 0.9 * dyn_crowd.run.frames);
-  const eval::WeightScore crowd_score = eval::scoreWeights(dyn_crowd.run.features);
+  const eval::WeightScore crowd_score = eval::score_weights(dyn_crowd.run.features);
   REQUIRE(crowd_score.moving > 50);  // the vehicles were seen and went through the BA
   CHECK(crowd_score.moving_rejected >= kMinMovingRejected);
   // Degradation against its own static twin, and far below the baseline.

@@ -6,19 +6,19 @@
 
 namespace dynavins::estimator {
 
-double yawOf(const Eigen::Matrix3d& R) { return std::atan2(R(1, 0), R(0, 0)); }
+double yaw_of(const Eigen::Matrix3d& R) { return std::atan2(R(1, 0), R(0, 0)); }
 
-Eigen::Matrix3d gravityAlignedRotation(const Eigen::Vector3d& mean_specific_force) {
+Eigen::Matrix3d gravity_aligned_rotation(const Eigen::Vector3d& mean_specific_force) {
   // Smallest rotation taking f onto +z, then the yaw removed: a rotation about z keeps +z fixed.
   const Eigen::Matrix3d R0 =
       Eigen::Quaterniond::FromTwoVectors(mean_specific_force.normalized(), Eigen::Vector3d::UnitZ())
           .toRotationMatrix();
-  return Eigen::AngleAxisd(-yawOf(R0), Eigen::Vector3d::UnitZ()).toRotationMatrix() * R0;
+  return Eigen::AngleAxisd(-yaw_of(R0), Eigen::Vector3d::UnitZ()).toRotationMatrix() * R0;
 }
 
-Eigen::Matrix3d rotationAligningGravity(const Eigen::Vector3d& g_c0) {
+Eigen::Matrix3d rotation_aligning_gravity(const Eigen::Vector3d& g_c0) {
   // Gravity acceleration points down, the specific force of a body at rest points up.
-  return gravityAlignedRotation(-g_c0);
+  return gravity_aligned_rotation(-g_c0);
 }
 
 }  // namespace dynavins::estimator

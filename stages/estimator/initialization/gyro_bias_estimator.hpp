@@ -15,7 +15,7 @@ namespace dynavins::estimator {
 /// R_wb[k]: body orientations of the N+1 frames in any common reference frame (e.g. from SfM);
 /// preints[k]: preintegration from frame k to k+1 (size N; all with the same linearisation bias).
 /// Throws std::invalid_argument on mismatched sizes; returns zero when fewer than one interval.
-Eigen::Vector3d estimateGyroBias(const std::vector<Eigen::Matrix3d>& R_wb,
-                                 const std::vector<const ImuPreintegration*>& preints);
+Eigen::Vector3d estimate_gyro_bias(const std::vector<Eigen::Matrix3d>& R_wb,
+                                 const std::vector<const imu::ImuPreintegration*>& preints);
 
 }  // namespace dynavins::estimator

@@ -7,7 +7,7 @@
 
 namespace dynavins::estimator {
 
-MonoInitResult initializeMono(const std::vector<InitWindowFrame>& window, const Eigen::Matrix3d& R_bc,
+MonoInitResult initialize_mono(const std::vector<InitWindowFrame>& window, const Eigen::Matrix3d& R_bc,
                               const Eigen::Vector3d& p_bc, const MonoInitOptions& o) {
   MonoInitResult res;
   const int n = static_cast<int>(window.size());
@@ -15,7 +15,7 @@ MonoInitResult initializeMono(const std::vector<InitWindowFrame>& window, const 
     res.reason = "initialisation needs at least 3 frames, got " + std::to_string(n);
     return res;
   }
-  std::vector<const ImuPreintegration*> preints;
+  std::vector<const imu::ImuPreintegration*> preints;
   for (int k = 1; k < n; ++k) {
     if (window[k].preint == nullptr) {
       res.reason = "frame " + std::to_string(k) + " has no preintegration";
@@ -27,7 +27,7 @@ MonoInitResult initializeMono(const std::vector<InitWindowFrame>& window, const 
   // §V-A: vision-only SfM, frame c0 = SfM reference frame l.
   std::vector<FrameFeatures> features;
   for (const InitWindowFrame& f : window) features.push_back(f.features);
-  const MonoSfmResult sfm = solveMonoSfm(features, o.sfm);
+  const MonoSfmResult sfm = solve_mono_sfm(features, o.sfm);
   if (!sfm.success) {
     res.reason = sfm.reason;
     return res;
@@ -38,11 +38,11 @@ MonoInitResult initializeMono(const std::vector<InitWindowFrame>& window, const 
   for (int k = 0; k < n; ++k) R_c0_b[k] = sfm.R_lc[k] * R_bc.transpose();
 
   // §V-B-1: gyroscope bias, then repropagation at the new bias (all intervals share it).
-  res.bg = preints.front()->linearizedBg() + estimateGyroBias(R_c0_b, preints);
-  for (int k = 1; k < n; ++k) window[k].preint->repropagate(window[k].preint->linearizedBa(), res.bg);
+  res.bg = preints.front()->linearized_bg() + estimate_gyro_bias(R_c0_b, preints);
+  for (int k = 1; k < n; ++k) window[k].preint->repropagate(window[k].preint->linearized_ba(), res.bg);
 
   // §V-B-2/3: velocities, gravity, scale.
-  const VisualInertialAlignment al = alignVisualInertial(R_c0_b, sfm.p_lc, preints, p_bc, o.alignment);
+  const VisualInertialAlignment al = align_visual_inertial(R_c0_b, sfm.p_lc, preints, p_bc, o.alignment);
   if (!al.success) {
     res.reason = al.reason;
     return res;
@@ -51,8 +51,8 @@ MonoInitResult initializeMono(const std::vector<InitWindowFrame>& window, const 
   res.scale_relative_std = al.scale_relative_std;
 
   // World: gravity on -z, then the yaw of frame 0's body removed (a rotation about z keeps gravity).
-  Eigen::Matrix3d R_wc0 = rotationAligningGravity(al.g_c0);
-  R_wc0 = Eigen::AngleAxisd(-yawOf(R_wc0 * R_c0_b[0]), Eigen::Vector3d::UnitZ()).toRotationMatrix() * R_wc0;
+  Eigen::Matrix3d R_wc0 = rotation_aligning_gravity(al.g_c0);
+  R_wc0 = Eigen::AngleAxisd(-yaw_of(R_wc0 * R_c0_b[0]), Eigen::Vector3d::UnitZ()).toRotationMatrix() * R_wc0;
   // Metric body positions in c0: p_b = s p̄_c - R_c0_b p_bc; origin moved to frame 0's body.
   std::vector<Eigen::Vector3d> p_c0_b(n);
   for (int k = 0; k < n; ++k) p_c0_b[k] = al.scale * sfm.p_lc[k] - R_c0_b[k] * p_bc;

@@ -20,10 +20,10 @@ namespace dynavins::estimator {
 struct InitWindowFrame {
   double t = 0.0;                         ///< frame time [s]
   FrameFeatures features;                 ///< cam0 normalized observations
-  ImuPreintegration* preint = nullptr;    ///< frame k-1 -> k; null for the first frame. Repropagated in place.
+  imu::ImuPreintegration* preint = nullptr;    ///< frame k-1 -> k; null for the first frame. Repropagated in place.
 };
 
-/// Settings of initializeMono(). The gravity magnitude is alignment.gravity_norm.
+/// Settings of initialize_mono(). The gravity magnitude is alignment.gravity_norm.
 struct MonoInitOptions {
   MonoSfmOptions sfm;
   VisualInertialAlignmentOptions alignment;
@@ -35,7 +35,7 @@ struct FeatureDepth {
   double depth = 0.0;  ///< z in the anchor camera [m]
 };
 
-/// Result of initializeMono(). World: z up (g_w = (0, 0, -g)), yaw of frame 0 zero, origin at frame 0's body.
+/// Result of initialize_mono(). World: z up (g_w = (0, 0, -g)), yaw of frame 0 zero, origin at frame 0's body.
 struct MonoInitResult {
   bool success = false;
   std::string reason;                      ///< why it failed (empty on success)
@@ -53,7 +53,7 @@ struct MonoInitResult {
 /// Initialises from a window (index 0 = oldest). R_bc, p_bc: cam0-to-body extrinsic. Once the SfM has
 /// succeeded the preintegrations are repropagated with the estimated gyroscope bias (and their own ba),
 /// even if the alignment then fails (as VINS-Mono). Never throws on bad data: success == false + reason.
-MonoInitResult initializeMono(const std::vector<InitWindowFrame>& window, const Eigen::Matrix3d& R_bc,
+MonoInitResult initialize_mono(const std::vector<InitWindowFrame>& window, const Eigen::Matrix3d& R_bc,
                               const Eigen::Vector3d& p_bc, const MonoInitOptions& options = {});
 
 }  // namespace dynavins::estimator

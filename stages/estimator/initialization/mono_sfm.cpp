@@ -24,18 +24,18 @@ struct CameraPose {
 
 // Reprojection error on the normalized plane, scaled to pixels so the loss scale reads in pixels.
 struct ReprojectionError {
-  ReprojectionError(const Eigen::Vector2d& obs, double focal) : obs_(obs), focal_(focal) {}
+  ReprojectionError(const Eigen::Vector2d& obs, double focal) : obs(obs), focal(focal) {}
   template <typename T>
   bool operator()(const T* q, const T* t, const T* p, T* r) const {
     const Eigen::Map<const Eigen::Quaternion<T>> q_cw(q);
     const Eigen::Map<const Eigen::Matrix<T, 3, 1>> t_cw(t), p_w(p);
     const Eigen::Matrix<T, 3, 1> p_c = q_cw * p_w + t_cw;
-    r[0] = T(focal_) * (p_c.x() / p_c.z() - T(obs_.x()));
-    r[1] = T(focal_) * (p_c.y() / p_c.z() - T(obs_.y()));
+    r[0] = T(focal) * (p_c.x() / p_c.z() - T(obs.x()));
+    r[1] = T(focal) * (p_c.y() / p_c.z() - T(obs.y()));
     return true;
   }
-  Eigen::Vector2d obs_;
-  double focal_;
+  Eigen::Vector2d obs;
+  double focal;
 };
 
 Eigen::Vector3d bearing(const Eigen::Vector2d& x) { return Eigen::Vector3d(x.x(), x.y(), 1.0).normalized(); }
@@ -58,14 +58,14 @@ Correspondences correspondences(const FrameFeatures& fa, const FrameFeatures& fb
   return c;
 }
 
-double meanParallaxPx(const Correspondences& c, double focal) {
+double mean_parallax_px(const Correspondences& c, double focal) {
   double sum = 0.0;
   for (size_t i = 0; i < c.a.size(); ++i) sum += (c.a[i] - c.b[i]).norm();
   return c.a.empty() ? 0.0 : focal * sum / static_cast<double>(c.a.size());
 }
 
 // Relative pose from the essential matrix: x_b = R x_a + t (|t| = 1). False when too few inliers survive.
-bool relativePoseFromEssential(const Correspondences& c, const MonoSfmOptions& o, Eigen::Matrix3d& R,
+bool relative_pose_from_essential(const Correspondences& c, const MonoSfmOptions& o, Eigen::Matrix3d& R,
                                Eigen::Vector3d& t) {
   if (c.a.size() < 8) return false;
   std::vector<cv::Point2d> pa, pb;
@@ -99,13 +99,13 @@ class SfmBuilder {
   MonoSfmResult run();
 
  private:
-  bool chooseReferenceFrame(int& l, Eigen::Matrix3d& R, Eigen::Vector3d& t, std::string& why) const;
-  void triangulatePair(int a, int b);
-  bool solvePnP(int k, int guess_from, std::string& why);
-  void triangulateRemaining();
-  bool bundleAdjust(std::string& why);
-  bool solveBundleAdjustment(std::string& why);
-  int removeOutlierPoints();
+  bool choose_reference_frame(int& l, Eigen::Matrix3d& R, Eigen::Vector3d& t, std::string& why) const;
+  void triangulate_pair(int a, int b);
+  bool solve_pn_p(int k, int guess_from, std::string& why);
+  void triangulate_remaining();
+  bool bundle_adjust(std::string& why);
+  bool solve_bundle_adjustment(std::string& why);
+  int remove_outlier_points();
 
   const std::vector<FrameFeatures>& frames_;
   const MonoSfmOptions& o_;
@@ -115,7 +115,7 @@ class SfmBuilder {
   int reference_ = 0;
 };
 
-bool SfmBuilder::chooseReferenceFrame(int& l, Eigen::Matrix3d& R, Eigen::Vector3d& t, std::string& why) const {
+bool SfmBuilder::choose_reference_frame(int& l, Eigen::Matrix3d& R, Eigen::Vector3d& t, std::string& why) const {
   const int newest = static_cast<int>(frames_.size()) - 1;
   int best_common = 0;
   double best_parallax = 0.0, best_translation_parallax = 0.0;
@@ -124,13 +124,13 @@ bool SfmBuilder::chooseReferenceFrame(int& l, Eigen::Matrix3d& R, Eigen::Vector3
     const int n = static_cast<int>(c.ids.size());
     best_common = std::max(best_common, n);
     if (n < o_.min_common_features) continue;
-    const double parallax = meanParallaxPx(c, o_.focal_px);
+    const double parallax = mean_parallax_px(c, o_.focal_px);
     best_parallax = std::max(best_parallax, parallax);
     if (parallax < o_.min_parallax_px) continue;
-    const double translation_parallax = rotationCompensatedParallaxPx(c.a, c.b, o_.focal_px);
+    const double translation_parallax = rotation_compensated_parallax_px(c.a, c.b, o_.focal_px);
     best_translation_parallax = std::max(best_translation_parallax, translation_parallax);
     if (translation_parallax < o_.min_translation_parallax_px) continue;
-    if (!relativePoseFromEssential(c, o_, R, t)) continue;
+    if (!relative_pose_from_essential(c, o_, R, t)) continue;
     l = i;
     return true;
   }
@@ -155,18 +155,18 @@ bool SfmBuilder::chooseReferenceFrame(int& l, Eigen::Matrix3d& R, Eigen::Vector3
   return false;
 }
 
-void SfmBuilder::triangulatePair(int a, int b) {
+void SfmBuilder::triangulate_pair(int a, int b) {
   const Correspondences c = correspondences(frames_[a], frames_[b]);
   const CameraPose &A = poses_[a], &B = poses_[b];
   for (size_t i = 0; i < c.ids.size(); ++i) {
     if (points_.count(c.ids[i])) continue;
     Eigen::Vector3d p;
-    if (triangulateTwoViews(A.q_cw.toRotationMatrix(), A.t_cw, c.a[i], B.q_cw.toRotationMatrix(), B.t_cw, c.b[i], p))
+    if (triangulate_two_views(A.q_cw.toRotationMatrix(), A.t_cw, c.a[i], B.q_cw.toRotationMatrix(), B.t_cw, c.b[i], p))
       points_[c.ids[i]] = p;
   }
 }
 
-bool SfmBuilder::solvePnP(int k, int guess_from, std::string& why) {
+bool SfmBuilder::solve_pn_p(int k, int guess_from, std::string& why) {
   std::vector<cv::Point3d> object;
   std::vector<cv::Point2d> image;
   for (const auto& [id, x] : frames_[k]) {
@@ -211,7 +211,7 @@ bool SfmBuilder::solvePnP(int k, int guess_from, std::string& why) {
   return true;
 }
 
-void SfmBuilder::triangulateRemaining() {
+void SfmBuilder::triangulate_remaining() {
   // Features not yet triangulated: use the first and last frames that observe them.
   std::map<FeatureId, std::pair<int, int>> span;
   for (int k = 0; k < static_cast<int>(frames_.size()); ++k)
@@ -224,13 +224,13 @@ void SfmBuilder::triangulateRemaining() {
     if (points_.count(id) || fl.first == fl.second) continue;
     const CameraPose &A = poses_[fl.first], &B = poses_[fl.second];
     Eigen::Vector3d p;
-    if (triangulateTwoViews(A.q_cw.toRotationMatrix(), A.t_cw, frames_[fl.first].at(id), B.q_cw.toRotationMatrix(),
+    if (triangulate_two_views(A.q_cw.toRotationMatrix(), A.t_cw, frames_[fl.first].at(id), B.q_cw.toRotationMatrix(),
                             B.t_cw, frames_[fl.second].at(id), p))
       points_[id] = p;
   }
 }
 
-bool SfmBuilder::solveBundleAdjustment(std::string& why) {
+bool SfmBuilder::solve_bundle_adjustment(std::string& why) {
   const int n = static_cast<int>(frames_.size());
   std::vector<std::array<double, 4>> q(n);
   std::vector<std::array<double, 3>> t(n);
@@ -286,7 +286,7 @@ bool SfmBuilder::solveBundleAdjustment(std::string& why) {
   return true;
 }
 
-int SfmBuilder::removeOutlierPoints() {
+int SfmBuilder::remove_outlier_points() {
   // A point behind a camera that sees it, or with any reprojection error above the threshold, is a bad
   // track (or badly triangulated): dropped whole. rms_px_ is measured on the points kept.
   double sq = 0.0;
@@ -318,13 +318,13 @@ int SfmBuilder::removeOutlierPoints() {
   return removed;
 }
 
-bool SfmBuilder::bundleAdjust(std::string& why) {
+bool SfmBuilder::bundle_adjust(std::string& why) {
   const size_t triangulated = points_.size();
-  if (!solveBundleAdjustment(why)) return false;
+  if (!solve_bundle_adjustment(why)) return false;
   // Outliers still pull the first solution a little (the Cauchy loss bounds it); solve again without them.
-  if (removeOutlierPoints() > 0) {
-    if (!solveBundleAdjustment(why)) return false;
-    removeOutlierPoints();
+  if (remove_outlier_points() > 0) {
+    if (!solve_bundle_adjustment(why)) return false;
+    remove_outlier_points();
   }
   if (static_cast<double>(points_.size()) < o_.min_inlier_point_fraction * static_cast<double>(triangulated)) {
     why = "SfM bundle adjustment kept only " + std::to_string(points_.size()) + " of " +
@@ -350,24 +350,24 @@ MonoSfmResult SfmBuilder::run() {
   int l = -1;
   Eigen::Matrix3d R;
   Eigen::Vector3d t;
-  if (!chooseReferenceFrame(l, R, t, res.reason)) return res;
+  if (!choose_reference_frame(l, R, t, res.reason)) return res;
   reference_ = l;
   poses_[newest].q_cw = Eigen::Quaterniond(R);  // x_newest = R x_l + t is the world(l)-to-camera map
   poses_[newest].t_cw = t;
 
   // Frames l+1 .. newest-1 by PnP, triangulating each against the newest frame; then against l.
   for (int i = l; i < newest; ++i) {
-    if (i > l && !solvePnP(i, i - 1, res.reason)) return res;
-    triangulatePair(i, newest);
+    if (i > l && !solve_pn_p(i, i - 1, res.reason)) return res;
+    triangulate_pair(i, newest);
   }
-  for (int i = l + 1; i < newest; ++i) triangulatePair(l, i);
+  for (int i = l + 1; i < newest; ++i) triangulate_pair(l, i);
   // Frames older than l, outward, triangulated against l.
   for (int i = l - 1; i >= 0; --i) {
-    if (!solvePnP(i, i + 1, res.reason)) return res;
-    triangulatePair(i, l);
+    if (!solve_pn_p(i, i + 1, res.reason)) return res;
+    triangulate_pair(i, l);
   }
-  triangulateRemaining();
-  if (!bundleAdjust(res.reason)) return res;
+  triangulate_remaining();
+  if (!bundle_adjust(res.reason)) return res;
 
   res.success = true;
   res.reference_frame = l;
@@ -383,7 +383,7 @@ MonoSfmResult SfmBuilder::run() {
 
 }  // namespace
 
-double rotationCompensatedParallaxPx(const std::vector<Eigen::Vector2d>& x_a, const std::vector<Eigen::Vector2d>& x_b,
+double rotation_compensated_parallax_px(const std::vector<Eigen::Vector2d>& x_a, const std::vector<Eigen::Vector2d>& x_b,
                                      double focal_px) {
   if (x_a.empty() || x_a.size() != x_b.size()) return 0.0;
   // Kabsch: R = argmax Σ f_b^T R f_a from the SVD of Σ f_b f_a^T.
@@ -408,7 +408,7 @@ double rotationCompensatedParallaxPx(const std::vector<Eigen::Vector2d>& x_a, co
   return *mid;
 }
 
-bool triangulateTwoViews(const Eigen::Matrix3d& R_cw_a, const Eigen::Vector3d& t_cw_a, const Eigen::Vector2d& x_a,
+bool triangulate_two_views(const Eigen::Matrix3d& R_cw_a, const Eigen::Vector3d& t_cw_a, const Eigen::Vector2d& x_a,
                          const Eigen::Matrix3d& R_cw_b, const Eigen::Vector3d& t_cw_b, const Eigen::Vector2d& x_b,
                          Eigen::Vector3d& p_w) {
   // x × (P X) = 0 for each view gives two rows per view (Hartley & Zisserman §12.2).
@@ -426,7 +426,7 @@ bool triangulateTwoViews(const Eigen::Matrix3d& R_cw_a, const Eigen::Vector3d& t
   return (R_cw_a * p_w + t_cw_a).z() > 0.0 && (R_cw_b * p_w + t_cw_b).z() > 0.0 && p_w.allFinite();
 }
 
-MonoSfmResult solveMonoSfm(const std::vector<FrameFeatures>& frames, const MonoSfmOptions& options) {
+MonoSfmResult solve_mono_sfm(const std::vector<FrameFeatures>& frames, const MonoSfmOptions& options) {
   return SfmBuilder(frames, options).run();
 }
 

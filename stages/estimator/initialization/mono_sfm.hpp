@@ -1,6 +1,6 @@
 #pragma once
 // Vision-only structure from motion over the initialisation window (VINS-Mono T-RO 2018 §V-A; VINS-Mono
-// code: relativePose + GlobalSFM::construct):
+// code: relative_pose + GlobalSFM::construct):
 //  1. reference frame l = the earliest frame with enough features in common with the newest frame and
 //     enough parallax (raw, and not explainable by a pure rotation);
 //  2. l <-> newest from the essential matrix (5-point RANSAC + cheirality), unit baseline;
@@ -19,7 +19,7 @@
 
 namespace dynavins::estimator {
 
-/// Settings of solveMonoSfm(). Pixel quantities are converted with focal_px to the normalized plane.
+/// Settings of solve_mono_sfm(). Pixel quantities are converted with focal_px to the normalized plane.
 struct MonoSfmOptions {
   double focal_px = 460.0;                ///< focal length used to express thresholds in pixels (VINS: 460)
   int min_common_features = 20;           ///< features shared by l and the newest frame (VINS: > 20)
@@ -38,7 +38,7 @@ struct MonoSfmOptions {
   int max_ba_iterations = 100;            ///< Ceres iterations of the final BA
 };
 
-/// Result of solveMonoSfm(). Poses and points are in frame l's camera coordinates, up to one scale.
+/// Result of solve_mono_sfm(). Poses and points are in frame l's camera coordinates, up to one scale.
 struct MonoSfmResult {
   bool success = false;
   std::string reason;                   ///< why it failed (empty on success)
@@ -51,16 +51,16 @@ struct MonoSfmResult {
 
 /// Runs the vision-only SfM on the frames' observations (index 0 = oldest, back() = newest).
 /// Never throws on bad data: returns success == false with a reason.
-MonoSfmResult solveMonoSfm(const std::vector<FrameFeatures>& frames, const MonoSfmOptions& options = {});
+MonoSfmResult solve_mono_sfm(const std::vector<FrameFeatures>& frames, const MonoSfmOptions& options = {});
 
 /// Median pixel displacement between matched bearings left after the least-squares pure rotation
 /// (Kabsch) that maps the first frame's bearings onto the second's. ~0 for a pure rotation.
-double rotationCompensatedParallaxPx(const std::vector<Eigen::Vector2d>& x_a, const std::vector<Eigen::Vector2d>& x_b,
+double rotation_compensated_parallax_px(const std::vector<Eigen::Vector2d>& x_a, const std::vector<Eigen::Vector2d>& x_b,
                                      double focal_px);
 
 /// Two-view linear (DLT) triangulation of a point in the world from world-to-camera poses
 /// (R_cw, t_cw) and normalized observations. Returns false when the point is not in front of both.
-bool triangulateTwoViews(const Eigen::Matrix3d& R_cw_a, const Eigen::Vector3d& t_cw_a, const Eigen::Vector2d& x_a,
+bool triangulate_two_views(const Eigen::Matrix3d& R_cw_a, const Eigen::Vector3d& t_cw_a, const Eigen::Vector2d& x_a,
                          const Eigen::Matrix3d& R_cw_b, const Eigen::Vector3d& t_cw_b, const Eigen::Vector2d& x_b,
                          Eigen::Vector3d& p_w);
 

@@ -22,16 +22,16 @@ struct LinearSystem {
   int rows = 0;      ///< stacked equations
 };
 
-LinearSystem buildSystem(const std::vector<Eigen::Matrix3d>& R, const std::vector<Eigen::Vector3d>& p,
-                         const std::vector<const ImuPreintegration*>& preints, const Eigen::Vector3d& p_bc,
+LinearSystem build_system(const std::vector<Eigen::Matrix3d>& R, const std::vector<Eigen::Vector3d>& p,
+                         const std::vector<const imu::ImuPreintegration*>& preints, const Eigen::Vector3d& p_bc,
                          const Eigen::Vector3d* g0, const Eigen::Matrix<double, 3, 2>* basis) {
   const int frames = static_cast<int>(R.size());
   const int gdim = basis ? 2 : 3;
   const int n = 3 * frames + gdim + 1;
   LinearSystem sys{Eigen::MatrixXd::Zero(n, n), Eigen::VectorXd::Zero(n)};
   for (int k = 0; k + 1 < frames; ++k) {
-    const ImuPreintegration& pre = *preints[k];
-    const double dt = pre.sumDt();
+    const imu::ImuPreintegration& pre = *preints[k];
+    const double dt = pre.sum_dt();
     const Eigen::Matrix3d Rk_t = R[k].transpose();
     const Eigen::Matrix3d R_rel = Rk_t * R[k + 1];
     // Local block over [v^bk, v^bk+1, g (3), s]; gravity mapped through the basis below.
@@ -40,11 +40,11 @@ LinearSystem buildSystem(const std::vector<Eigen::Matrix3d>& R, const std::vecto
     H.block<3, 3>(0, 0) = -dt * Eigen::Matrix3d::Identity();
     H.block<3, 3>(0, 6) = -0.5 * dt * dt * Rk_t;
     H.block<3, 1>(0, 9) = Rk_t * (p[k + 1] - p[k]) / kScaleConditioning;
-    z.head<3>() = pre.deltaP() - p_bc + R_rel * p_bc;
+    z.head<3>() = pre.delta_p() - p_bc + R_rel * p_bc;
     H.block<3, 3>(3, 0) = -Eigen::Matrix3d::Identity();
     H.block<3, 3>(3, 3) = R_rel;
     H.block<3, 3>(3, 6) = -dt * Rk_t;
-    z.tail<3>() = pre.deltaV();
+    z.tail<3>() = pre.delta_v();
     // Reduce gravity to the refinement's 2 tangent parameters: g = g0 + B w.
     Eigen::MatrixXd Hk(6, 6 + gdim + 1);
     Hk.leftCols<6>() = H.leftCols<6>();
@@ -72,11 +72,11 @@ LinearSystem buildSystem(const std::vector<Eigen::Matrix3d>& R, const std::vecto
 
 }  // namespace
 
-double accelerometerExcitation(const std::vector<Eigen::Matrix3d>& R_c0_b,
-                               const std::vector<const ImuPreintegration*>& preints) {
+double accelerometer_excitation(const std::vector<Eigen::Matrix3d>& R_c0_b,
+                               const std::vector<const imu::ImuPreintegration*>& preints) {
   std::vector<Eigen::Vector3d> f;
   for (size_t k = 0; k < preints.size() && k < R_c0_b.size(); ++k)
-    if (preints[k]->sumDt() > 0.0) f.push_back(R_c0_b[k] * preints[k]->deltaV() / preints[k]->sumDt());
+    if (preints[k]->sum_dt() > 0.0) f.push_back(R_c0_b[k] * preints[k]->delta_v() / preints[k]->sum_dt());
   if (f.size() < 2) return 0.0;
   Eigen::Vector3d mean = Eigen::Vector3d::Zero();
   for (const Eigen::Vector3d& x : f) mean += x;
@@ -86,7 +86,7 @@ double accelerometerExcitation(const std::vector<Eigen::Matrix3d>& R_c0_b,
   return std::sqrt(ss / static_cast<double>(f.size()));
 }
 
-Eigen::Matrix<double, 3, 2> gravityTangentBasis(const Eigen::Vector3d& g) {
+Eigen::Matrix<double, 3, 2> gravity_tangent_basis(const Eigen::Vector3d& g) {
   const Eigen::Vector3d a = g.normalized();
   // Any axis not parallel to g seeds the basis.
   Eigen::Vector3d seed = std::abs(a.z()) < 0.9 ? Eigen::Vector3d::UnitZ() : Eigen::Vector3d::UnitX();
@@ -97,15 +97,15 @@ Eigen::Matrix<double, 3, 2> gravityTangentBasis(const Eigen::Vector3d& g) {
   return B;
 }
 
-VisualInertialAlignment alignVisualInertial(const std::vector<Eigen::Matrix3d>& R_c0_b,
+VisualInertialAlignment align_visual_inertial(const std::vector<Eigen::Matrix3d>& R_c0_b,
                                             const std::vector<Eigen::Vector3d>& p_c0_c,
-                                            const std::vector<const ImuPreintegration*>& preints,
+                                            const std::vector<const imu::ImuPreintegration*>& preints,
                                             const Eigen::Vector3d& p_bc,
                                             const VisualInertialAlignmentOptions& o) {
   if (R_c0_b.size() != p_c0_c.size() || preints.size() + 1 != R_c0_b.size())
-    throw std::invalid_argument("alignVisualInertial: need N+1 poses and N preintegrations");
-  for (const ImuPreintegration* p : preints)
-    if (p == nullptr) throw std::invalid_argument("alignVisualInertial: null preintegration");
+    throw std::invalid_argument("align_visual_inertial: need N+1 poses and N preintegrations");
+  for (const imu::ImuPreintegration* p : preints)
+    if (p == nullptr) throw std::invalid_argument("align_visual_inertial: null preintegration");
   VisualInertialAlignment res;
   const int frames = static_cast<int>(R_c0_b.size());
   if (frames < 3) {
@@ -113,7 +113,7 @@ VisualInertialAlignment alignVisualInertial(const std::vector<Eigen::Matrix3d>& 
     return res;
   }
 
-  res.excitation = accelerometerExcitation(R_c0_b, preints);
+  res.excitation = accelerometer_excitation(R_c0_b, preints);
   if (o.min_excitation > 0.0 && !(res.excitation >= o.min_excitation)) {
     res.reason = "alignment: accelerometer excitation " + std::to_string(res.excitation) + " m/s^2 (need " +
                  std::to_string(o.min_excitation) + "): the acceleration barely varies across the window, so the "
@@ -122,7 +122,7 @@ VisualInertialAlignment alignVisualInertial(const std::vector<Eigen::Matrix3d>& 
   }
 
   // §V-B-2: free gravity, stacked over all consecutive pairs, solved by least squares.
-  const LinearSystem free = buildSystem(R_c0_b, p_c0_c, preints, p_bc, nullptr, nullptr);
+  const LinearSystem free = build_system(R_c0_b, p_c0_c, preints, p_bc, nullptr, nullptr);
   const Eigen::VectorXd x = free.A.ldlt().solve(free.b);
   const double s_free = x(3 * frames + 3) / kScaleConditioning;
   Eigen::Vector3d g = x.segment<3>(3 * frames);
@@ -142,8 +142,8 @@ VisualInertialAlignment alignVisualInertial(const std::vector<Eigen::Matrix3d>& 
   g = o.gravity_norm * g.normalized();
   LinearSystem sys;
   for (int it = 0; it < o.refinement_iterations; ++it) {
-    const Eigen::Matrix<double, 3, 2> B = gravityTangentBasis(g);
-    sys = buildSystem(R_c0_b, p_c0_c, preints, p_bc, &g, &B);
+    const Eigen::Matrix<double, 3, 2> B = gravity_tangent_basis(g);
+    sys = build_system(R_c0_b, p_c0_c, preints, p_bc, &g, &B);
     xr = sys.A.ldlt().solve(sys.b);
     g = o.gravity_norm * (g + B * xr.segment<2>(3 * frames)).normalized();
   }

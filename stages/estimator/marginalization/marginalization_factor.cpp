@@ -12,23 +12,23 @@ namespace dynavins::estimator {
 
 MarginalizationFactor::MarginalizationFactor(std::shared_ptr<const MarginalizationInfo> info)
     : info_(std::move(info)) {
-  if (!info_ || info_->keptSizes().empty() || info_->linearizedJacobian().rows() == 0) {
+  if (!info_ || info_->kept_sizes().empty() || info_->linearized_jacobian().rows() == 0) {
     throw std::invalid_argument("MarginalizationFactor: the MarginalizationInfo was not marginalized");
   }
-  for (int size : info_->keptSizes()) mutable_parameter_block_sizes()->push_back(size);
-  set_num_residuals(static_cast<int>(info_->linearizedJacobian().rows()));
+  for (int size : info_->kept_sizes()) mutable_parameter_block_sizes()->push_back(size);
+  set_num_residuals(static_cast<int>(info_->linearized_jacobian().rows()));
 }
 
 bool MarginalizationFactor::Evaluate(double const* const* parameters, double* residuals,
                                      double** jacobians) const {
-  const std::vector<int>& sizes = info_->keptSizes();
-  const std::vector<int>& offsets = info_->keptTangentOffsets();
-  const std::vector<Eigen::VectorXd>& x0 = info_->keptLinearizationPoint();
-  const Eigen::MatrixXd& J = info_->linearizedJacobian();
+  const std::vector<int>& sizes = info_->kept_sizes();
+  const std::vector<int>& offsets = info_->kept_tangent_offsets();
+  const std::vector<Eigen::VectorXd>& x0 = info_->kept_linearization_point();
+  const Eigen::MatrixXd& J = info_->linearized_jacobian();
   const int rows = static_cast<int>(J.rows());
 
   // dx = x ⊖ x0, plus d(dx)/d(tangent) for the pose rotations (Jr^-1; identity elsewhere).
-  Eigen::VectorXd dx(info_->keptTangentSize());
+  Eigen::VectorXd dx(info_->kept_tangent_size());
   std::vector<Eigen::Matrix3d> jr_inv(sizes.size(), Eigen::Matrix3d::Identity());
   for (size_t i = 0; i < sizes.size(); ++i) {
     const int o = offsets[i];
@@ -39,13 +39,13 @@ bool MarginalizationFactor::Evaluate(double const* const* parameters, double* re
       dx.segment<3>(o) = p - x0[i].head<3>();
       const Eigen::Vector3d dtheta = so3::log((q0.conjugate() * q).normalized().toRotationMatrix());
       dx.segment<3>(o + 3) = dtheta;
-      jr_inv[i] = so3::rightJacobianInverse(dtheta);
+      jr_inv[i] = so3::right_jacobian_inverse(dtheta);
     } else {
       dx.segment(o, sizes[i]) = Eigen::Map<const Eigen::VectorXd>(parameters[i], sizes[i]) - x0[i];
     }
   }
 
-  Eigen::Map<Eigen::VectorXd>(residuals, rows) = info_->linearizedResidual() + J * dx;
+  Eigen::Map<Eigen::VectorXd>(residuals, rows) = info_->linearized_residual() + J * dx;
 
   if (jacobians == nullptr) return true;
   for (size_t i = 0; i < sizes.size(); ++i) {

@@ -16,8 +16,8 @@ namespace dynavins::estimator {
 
 class MarginalizationFactor final : public ceres::CostFunction {
  public:
-  /// `info` must have been marginalize()d. Parameter blocks: info->keptBlocks(shift) (ambient sizes
-  /// info->keptSizes()); residuals: info->linearizedJacobian().rows().
+  /// `info` must have been marginalize()d. Parameter blocks: info->kept_blocks(shift) (ambient sizes
+  /// info->kept_sizes()); residuals: info->linearized_jacobian().rows().
   explicit MarginalizationFactor(std::shared_ptr<const MarginalizationInfo> info);
 
   bool Evaluate(double const* const* parameters, double* residuals, double** jacobians) const override;

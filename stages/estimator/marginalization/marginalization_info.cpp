@@ -23,7 +23,7 @@ using MutMap = Eigen::Map<Eigen::MatrixXd>;
 ///   ρ'' >  0:  α = 1 - sqrt(1 + 2 s ρ''/ρ'),  r <- sqrt(ρ')/(1-α) r,  J <- sqrt(ρ') (I - α r r^T/s) J
 /// so that (J^T J, J^T r) is the Hessian/gradient the solver itself forms for that residual.
 /// `jacobian` holds every block's tangent Jacobian side by side (rows x total tangent columns).
-void applyLoss(const ceres::LossFunction& loss, Eigen::Map<Eigen::VectorXd> r, MutMap jacobian) {
+void apply_loss(const ceres::LossFunction& loss, Eigen::Map<Eigen::VectorXd> r, MutMap jacobian) {
   const double sq_norm = r.squaredNorm();
   double rho[3];
   loss.Evaluate(sq_norm, rho);
@@ -56,7 +56,7 @@ void applyLoss(const ceres::LossFunction& loss, Eigen::Map<Eigen::VectorXd> r, M
 MarginalizationInfo::MarginalizationInfo(double eigenvalue_threshold)
     : eigenvalue_threshold_(eigenvalue_threshold) {}
 
-int MarginalizationInfo::tangentSize(int ambient_size) {
+int MarginalizationInfo::tangent_size(int ambient_size) {
   return ambient_size == kPoseSize ? kPoseTangentSize : ambient_size;
 }
 
@@ -101,7 +101,7 @@ void MarginalizationInfo::linearize() {
   for (size_t k = 0; k < residuals_.size(); ++k) {
     lin_offset_[k] = total;
     int cols = 0;
-    for (int b : residual_blocks_[k]) cols += tangentSize(sizes_[b]);
+    for (int b : residual_blocks_[k]) cols += tangent_size(sizes_[b]);
     total += static_cast<size_t>(residuals_[k].cost->num_residuals()) * (1 + cols);
   }
   lin_data_.assign(total, 0.0);
@@ -115,7 +115,7 @@ void MarginalizationInfo::linearize() {
     int ambient_cols = 0, tangent_cols = 0;
     for (int b : blocks) {
       ambient_cols += sizes_[b];
-      tangent_cols += tangentSize(sizes_[b]);
+      tangent_cols += tangent_size(sizes_[b]);
     }
     ambient.assign(static_cast<size_t>(rows) * ambient_cols, 0.0);
     jacobian_ptrs.resize(blocks.size());
@@ -132,12 +132,12 @@ void MarginalizationInfo::linearize() {
     double* tangent = residual + rows;
     for (size_t i = 0; i < blocks.size(); ++i) {
       const int size = sizes_[blocks[i]];
-      const int t = tangentSize(size);
+      const int t = tangent_size(size);
       MutMap(tangent, rows, t) = Eigen::Map<const RowMajorMatrix>(jacobian_ptrs[i], rows, size).leftCols(t);
       tangent += static_cast<size_t>(rows) * t;
     }
     if (res.loss) {
-      applyLoss(*res.loss, Eigen::Map<Eigen::VectorXd>(residual, rows), MutMap(residual + rows, rows, tangent_cols));
+      apply_loss(*res.loss, Eigen::Map<Eigen::VectorXd>(residual, rows), MutMap(residual + rows, rows, tangent_cols));
     }
   }
   x0_.clear();
@@ -157,7 +157,7 @@ struct MarginalizationInfo::ScalarBlock {
 
 namespace {
 /// Copies the upper triangle of a square matrix into its lower one.
-void mirrorUpperTriangle(Eigen::MatrixXd& H) {
+void mirror_upper_triangle(Eigen::MatrixXd& H) {
   const int total = static_cast<int>(H.rows());
   for (int j = 0; j < total; ++j) {
     for (int i = j + 1; i < total; ++i) H(i, j) = H(j, i);
@@ -165,7 +165,7 @@ void mirrorUpperTriangle(Eigen::MatrixXd& H) {
 }
 }  // namespace
 
-int MarginalizationInfo::denseColumnOffsets(const std::vector<char>& scalar, std::vector<int>& offset,
+int MarginalizationInfo::dense_column_offsets(const std::vector<char>& scalar, std::vector<int>& offset,
                                             int& dropped_dense_size) const {
   const int num_blocks = static_cast<int>(blocks_.size());
   // Non-scalar dropped blocks first (in order of appearance), then the kept ones; scalar ones get -1.
@@ -174,20 +174,20 @@ int MarginalizationInfo::denseColumnOffsets(const std::vector<char>& scalar, std
   for (int i = 0; i < num_blocks; ++i) {
     if (is_dropped_[i] && !scalar[i]) {
       offset[i] = total;
-      total += tangentSize(sizes_[i]);
+      total += tangent_size(sizes_[i]);
     }
   }
   dropped_dense_size = total;
   for (int i = 0; i < num_blocks; ++i) {
     if (!is_dropped_[i]) {
       offset[i] = total;
-      total += tangentSize(sizes_[i]);
+      total += tangent_size(sizes_[i]);
     }
   }
   return total;
 }
 
-std::vector<MarginalizationInfo::ScalarBlock> MarginalizationInfo::scalarBlocks(
+std::vector<MarginalizationInfo::ScalarBlock> MarginalizationInfo::scalar_blocks(
     const std::vector<char>& scalar, std::vector<int>& scalar_id, std::vector<int>& residual_scalar) const {
   const int num_blocks = static_cast<int>(blocks_.size());
   scalar_id.assign(num_blocks, -1);
@@ -216,14 +216,14 @@ std::vector<MarginalizationInfo::ScalarBlock> MarginalizationInfo::scalarBlocks(
     s.local.resize(s.neighbours.size());
     for (size_t j = 0; j < s.neighbours.size(); ++j) {
       s.local[j] = n;
-      n += tangentSize(sizes_[s.neighbours[j]]);
+      n += tangent_size(sizes_[s.neighbours[j]]);
     }
     s.c = Eigen::VectorXd::Zero(n);
   }
   return scalars;
 }
 
-void MarginalizationInfo::accumulateNormalEquations(const std::vector<int>& offset, const std::vector<int>& scalar_id,
+void MarginalizationInfo::accumulate_normal_equations(const std::vector<int>& offset, const std::vector<int>& scalar_id,
                                                     const std::vector<int>& residual_scalar,
                                                     std::vector<ScalarBlock>& scalars, Eigen::MatrixXd& H,
                                                     Eigen::VectorXd& b) const {
@@ -237,10 +237,10 @@ void MarginalizationInfo::accumulateNormalEquations(const std::vector<int>& offs
     col.resize(blocks.size());
     for (size_t i = 0, c = 0; i < blocks.size(); ++i) {
       col[i] = static_cast<int>(c);
-      c += tangentSize(sizes_[blocks[i]]);
+      c += tangent_size(sizes_[blocks[i]]);
     }
     auto J = [&](size_t i) {
-      return ConstMap(jac + static_cast<size_t>(rows) * col[i], rows, tangentSize(sizes_[blocks[i]]));
+      return ConstMap(jac + static_cast<size_t>(rows) * col[i], rows, tangent_size(sizes_[blocks[i]]));
     };
     const int si = residual_scalar[k];
     for (size_t i = 0; i < blocks.size(); ++i) {
@@ -271,7 +271,7 @@ void MarginalizationInfo::accumulateNormalEquations(const std::vector<int>& offs
   }
 }
 
-bool MarginalizationInfo::eliminateScalarBlocks(const std::vector<ScalarBlock>& scalars, const std::vector<int>& offset,
+bool MarginalizationInfo::eliminate_scalar_blocks(const std::vector<ScalarBlock>& scalars, const std::vector<int>& offset,
                                                 Eigen::MatrixXd& H, Eigen::VectorXd& b) const {
   // H -= c c^T / h_dd, b -= c b_d / h_dd (H_dd is diagonal over the scalar blocks).
   for (const ScalarBlock& s : scalars) {
@@ -280,13 +280,13 @@ bool MarginalizationInfo::eliminateScalarBlocks(const std::vector<ScalarBlock>& 
     const Eigen::VectorXd c_scaled = s.c * inv_h;
     for (size_t i = 0; i < s.neighbours.size(); ++i) {
       const int oi = offset[s.neighbours[i]];
-      const int ti = tangentSize(sizes_[s.neighbours[i]]);
+      const int ti = tangent_size(sizes_[s.neighbours[i]]);
       const auto ci = s.c.segment(s.local[i], ti);
       b.segment(oi, ti) -= ci * (s.b * inv_h);
       for (size_t j = 0; j < s.neighbours.size(); ++j) {
         const int oj = offset[s.neighbours[j]];
         if (oj < oi) continue;
-        const int tj = tangentSize(sizes_[s.neighbours[j]]);
+        const int tj = tangent_size(sizes_[s.neighbours[j]]);
         H.block(oi, oj, ti, tj).noalias() -= ci * c_scaled.segment(s.local[j], tj).transpose();
       }
     }
@@ -297,17 +297,17 @@ bool MarginalizationInfo::eliminateScalarBlocks(const std::vector<ScalarBlock>& 
 bool MarginalizationInfo::assemble(const std::vector<char>& scalar, Eigen::MatrixXd& H, Eigen::VectorXd& b,
                                    int& dropped_dense_size) const {
   std::vector<int> offset;
-  const int total = denseColumnOffsets(scalar, offset, dropped_dense_size);
+  const int total = dense_column_offsets(scalar, offset, dropped_dense_size);
   std::vector<int> scalar_id, residual_scalar;
-  std::vector<ScalarBlock> scalars = scalarBlocks(scalar, scalar_id, residual_scalar);
+  std::vector<ScalarBlock> scalars = scalar_blocks(scalar, scalar_id, residual_scalar);
   // Gauss-Newton system H = Σ J^T J, b = Σ J^T r over all residual blocks; the dense part in its upper
   // triangle (blocks above the diagonal, diagonal blocks whole), mirrored below once the scalar blocks
   // are eliminated.
   H.setZero(total, total);
   b.setZero(total);
-  accumulateNormalEquations(offset, scalar_id, residual_scalar, scalars, H, b);
-  if (!eliminateScalarBlocks(scalars, offset, H, b)) return false;
-  mirrorUpperTriangle(H);
+  accumulate_normal_equations(offset, scalar_id, residual_scalar, scalars, H, b);
+  if (!eliminate_scalar_blocks(scalars, offset, H, b)) return false;
+  mirror_upper_triangle(H);
   return true;
 }
 
@@ -325,7 +325,7 @@ void MarginalizationInfo::marginalize() {
     kept_sizes_.push_back(sizes_[i]);
     kept_tangent_offsets_.push_back(kept_tangent_size_);
     kept_x0_.push_back(x0_[i]);
-    kept_tangent_size_ += tangentSize(sizes_[i]);
+    kept_tangent_size_ += tangent_size(sizes_[i]);
   }
   if (kept_blocks_.empty()) throw std::runtime_error("MarginalizationInfo::marginalize: no block is kept");
 
@@ -334,7 +334,7 @@ void MarginalizationInfo::marginalize() {
   // while H is formed, which is the same Schur complement (H_dd is positive definite; H is positive
   // semi-definite, so the rest of H_mm's pseudo-inverse is unaffected) without the dense m x m work.
   std::vector<char> scalar(blocks_.size(), 0);
-  for (size_t i = 0; i < blocks_.size(); ++i) scalar[i] = is_dropped_[i] && tangentSize(sizes_[i]) == 1;
+  for (size_t i = 0; i < blocks_.size(); ++i) scalar[i] = is_dropped_[i] && tangent_size(sizes_[i]) == 1;
   for (const std::vector<int>& blocks : residual_blocks_) {
     int count = 0;
     for (int blk : blocks) count += scalar[blk] ? 1 : 0;
@@ -395,7 +395,7 @@ void MarginalizationInfo::marginalize() {
   residuals_.clear();
 }
 
-std::vector<double*> MarginalizationInfo::keptBlocks(
+std::vector<double*> MarginalizationInfo::kept_blocks(
     const std::unordered_map<const double*, double*>& shift) const {
   std::vector<double*> out;
   out.reserve(kept_blocks_.size());

@@ -32,7 +32,7 @@ struct ResidualBlockInfo {
 
 /// Collects residual blocks, linearises them and eliminates the dropped states (see file comment).
 /// Use: add() every block touching a dropped state, linearize(), marginalize(); then build a
-/// MarginalizationFactor on keptBlocks(shift).
+/// MarginalizationFactor on kept_blocks(shift).
 class MarginalizationInfo {
  public:
   /// `eigenvalue_threshold`: eigenvalues of H_mm and H* at or below it are treated as zero (the prior
@@ -53,30 +53,30 @@ class MarginalizationInfo {
   void linearize();
 
   /// Forms H and b, takes the Schur complement onto the kept blocks and factors it into
-  /// linearizedJacobian() / linearizedResidual(). Throws std::logic_error if linearize() was not called
+  /// linearized_jacobian() / linearized_residual(). Throws std::logic_error if linearize() was not called
   /// and std::runtime_error if no block is kept or the Schur complement has no eigenvalue above the
   /// threshold (nothing to keep). Releases the added residual blocks (their costs and losses).
   void marginalize();
 
-  /// Kept blocks in column order of linearizedJacobian(), at their addresses after a window shift:
+  /// Kept blocks in column order of linearized_jacobian(), at their addresses after a window shift:
   /// `shift` maps an old address to its new one; blocks absent from the map keep their address.
-  std::vector<double*> keptBlocks(const std::unordered_map<const double*, double*>& shift = {}) const;
+  std::vector<double*> kept_blocks(const std::unordered_map<const double*, double*>& shift = {}) const;
   /// Ambient sizes of the kept blocks (7 = pose, else Euclidean), in column order.
-  const std::vector<int>& keptSizes() const { return kept_sizes_; }
-  /// Column offset of each kept block in linearizedJacobian() (tangent coordinates).
-  const std::vector<int>& keptTangentOffsets() const { return kept_tangent_offsets_; }
-  /// Sum of the kept blocks' tangent sizes: the columns of linearizedJacobian().
-  int keptTangentSize() const { return kept_tangent_size_; }
+  const std::vector<int>& kept_sizes() const { return kept_sizes_; }
+  /// Column offset of each kept block in linearized_jacobian() (tangent coordinates).
+  const std::vector<int>& kept_tangent_offsets() const { return kept_tangent_offsets_; }
+  /// Sum of the kept blocks' tangent sizes: the columns of linearized_jacobian().
+  int kept_tangent_size() const { return kept_tangent_size_; }
   /// Values of the kept blocks at linearisation (x0), in column order.
-  const std::vector<Eigen::VectorXd>& keptLinearizationPoint() const { return kept_x0_; }
+  const std::vector<Eigen::VectorXd>& kept_linearization_point() const { return kept_x0_; }
 
-  /// J (m x keptTangentSize()), m = rank of the Schur complement.
-  const Eigen::MatrixXd& linearizedJacobian() const { return linearized_jacobian_; }
+  /// J (m x kept_tangent_size()), m = rank of the Schur complement.
+  const Eigen::MatrixXd& linearized_jacobian() const { return linearized_jacobian_; }
   /// r0 (m).
-  const Eigen::VectorXd& linearizedResidual() const { return linearized_residual_; }
+  const Eigen::VectorXd& linearized_residual() const { return linearized_residual_; }
 
   /// Tangent size of a block of ambient size `ambient_size` (7 -> 6, else unchanged).
-  static int tangentSize(int ambient_size);
+  static int tangent_size(int ambient_size);
 
  private:
   /// Forms the Gauss-Newton system over the "dense" columns (non-scalar dropped blocks first, then the
@@ -88,19 +88,19 @@ class MarginalizationInfo {
   struct ScalarBlock;
   /// assemble()'s phases. Column offset of every block in the dense system (-1 for the scalar ones);
   /// returns the system's size, `dropped_dense_size` the size of its dropped part.
-  int denseColumnOffsets(const std::vector<char>& scalar, std::vector<int>& offset, int& dropped_dense_size) const;
+  int dense_column_offsets(const std::vector<char>& scalar, std::vector<int>& offset, int& dropped_dense_size) const;
   /// One ScalarBlock (neighbours known, sums zero) per scalar block; `scalar_id` per block: its index there
   /// or -1; `residual_scalar` per residual: the position of its scalar block among its blocks, or -1.
-  std::vector<ScalarBlock> scalarBlocks(const std::vector<char>& scalar, std::vector<int>& scalar_id,
+  std::vector<ScalarBlock> scalar_blocks(const std::vector<char>& scalar, std::vector<int>& scalar_id,
                                         std::vector<int>& residual_scalar) const;
   /// Adds every residual's J^T J and J^T r: the dense blocks' into the upper triangle of H and into b,
   /// the scalar blocks' into their ScalarBlock.
-  void accumulateNormalEquations(const std::vector<int>& offset, const std::vector<int>& scalar_id,
+  void accumulate_normal_equations(const std::vector<int>& offset, const std::vector<int>& scalar_id,
                                  const std::vector<int>& residual_scalar, std::vector<ScalarBlock>& scalars,
                                  Eigen::MatrixXd& H, Eigen::VectorXd& b) const;
   /// Schur complement of the scalar blocks into the upper triangle of H and into b; false if one of them
   /// has no information (h_dd at or below the threshold).
-  bool eliminateScalarBlocks(const std::vector<ScalarBlock>& scalars, const std::vector<int>& offset,
+  bool eliminate_scalar_blocks(const std::vector<ScalarBlock>& scalars, const std::vector<int>& offset,
                              Eigen::MatrixXd& H, Eigen::VectorXd& b) const;
 
   double eigenvalue_threshold_;
