@@ -202,6 +202,20 @@ bool SlidingWindowEstimator::Impl::initialize_stereo(std::string* why) {
     *why = "only " + std::to_string(with_depth) + " stereo points in the window";
     return false;
   }
+  // Every frame needs a pose of its own from the stereo points (pnp_newest: at least 10): a frame that saw
+  // none (black images just after a reset) holds an IMU guess only, and velocities differenced from it
+  // start the new track at the wrong speed, to jump once that frame leaves the window (test_vio_faults).
+  std::vector<int> seen(newest + 1, 0);  // stereo points observed in each slot, the anchors' own included
+  for (const auto& [id, f] : features.all()) {
+    if (!f.has_depth) continue;
+    for (int k = f.start_slot; k <= f.end_slot(); ++k) ++seen[k];
+  }
+  for (int k = 0; k <= newest; ++k) {
+    if (seen[k] < 10) {
+      *why = "window frame " + std::to_string(k) + " sees only " + std::to_string(seen[k]) + " stereo points";
+      return false;
+    }
+  }
   std::vector<Eigen::Matrix3d> R_wb;
   std::vector<const imu::ImuPreintegration*> pre;
   for (int k = 0; k <= newest; ++k) {
