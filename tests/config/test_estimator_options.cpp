@@ -382,7 +382,9 @@ TEST_CASE("Every key of the table, set with --set, takes effect and is marked (-
   for (const OptionSpec& spec : option_specs()) kv.emplace_back(spec.key, other_value(spec));
   const auto o = EstimatorOptions::load(kEuroc + "euroc_stereo_imu_config.yaml", kv);
   const std::string printed = o.print();
-  for (const auto& [key, written] : kv) {
+  for (const auto& entry : kv) {
+    const std::string& key = entry.first;  // not a structured binding: C++17 lambdas cannot capture those
+    const std::string& written = entry.second;
     INFO(key << " set " << written << ", got " << o.value(key));
     const OptionSpec& spec = *std::find_if(option_specs().begin(), option_specs().end(),
                                           [&](const OptionSpec& x) { return key == x.key; });
