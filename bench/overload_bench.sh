@@ -6,6 +6,7 @@
 # resets, tracking share, peak RSS and ATE. Writes bench/results/overload.md.
 # Usage: bench/overload_bench.sh [SCENE_DIR] [REPS] [RATE ...]   (default: bench/cache/high-20s 3 1 2 5 10)
 set -euo pipefail
+args="$*"
 cd "$(dirname "$0")/.."
 scene=$(readlink -f "${1:-bench/cache/high-20s}") reps=${2:-3}
 shift $(( $# > 2 ? 2 : $# ))
@@ -39,7 +40,7 @@ PY
 {
   echo "# Overload: replay faster than real time (real-time policy)"
   echo
-  echo "\`bench/overload_bench.sh $*\` on \`$(basename "$scene")\` ($(nproc) cores, load average $(cut -d' ' -f1-3 /proc/loadavg) at the start), $(date -u +%F)."
+  echo "\`bench/overload_bench.sh $args\` on \`$(basename "$scene")\` ($(nproc) cores, load average $(cut -d' ' -f1-3 /proc/loadavg) at the start), $(date -u +%F)."
   echo "Rate 0 is the lossless reference (every frame processed, as fast as possible). Loop closure off."
   echo
   echo "| rate | wall s | frames in | dropped | estimated | IMU samples in / in log | IMU queue drops | resets | tracking | peak RSS MB | ATE m |"
