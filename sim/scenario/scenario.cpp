@@ -129,9 +129,10 @@ std::shared_ptr<const SmoothTrajectory> build_recorded_trajectory(const Scenario
 std::shared_ptr<const SmoothTrajectory> build_body_trajectory(const ScenarioSpec& spec) {
   if (!spec.tum_file.empty()) return build_recorded_trajectory(spec);
   std::vector<PathWaypoint> corners;
-  for (const auto& w : spec.waypoints) {
+  for (std::size_t i = 0; i < spec.waypoints.size(); ++i) {
     PathWaypoint p;
-    p.p = w;
+    p.p = spec.waypoints[i];
+    if (i < spec.dwell.size()) p.dwell = spec.dwell[i];
     corners.push_back(p);
   }
   try {

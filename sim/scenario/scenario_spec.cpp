@@ -1,5 +1,6 @@
 #include "sim/scenario/scenario_spec.hpp"
 
+#include <cmath>
 #include <filesystem>
 #include <set>
 #include <stdexcept>
@@ -141,12 +142,23 @@ ScenarioSpec load_scenario(const std::string& path) {
     }
     s.tum_body_axes = r.text(motion, "body_axes", "sim", {"sim", "euroc"});
   } else {
-    r.only(motion, "motion", {"profile", "cruise_speed", "waypoints"});
+    r.only(motion, "motion", {"profile", "cruise_speed", "waypoints", "dwell"});
     s.profile = r.text(motion, "profile", "drone", {"car", "drone", "handheld"});
     s.cruise_speed = r.number(motion, "cruise_speed", false, 0);
     const auto w = Reader{path}.numbers(motion, "waypoints", 3);
     for (std::size_t i = 0; i < w.size(); i += 3) s.waypoints.emplace_back(w[i], w[i + 1], w[i + 2]);
     if (s.waypoints.size() < 2) r.fail("motion.waypoints", "needs at least two (x, y, z) corners");
+    s.dwell.assign(s.waypoints.size(), 0.0);
+    if (!motion["dwell"].empty()) {
+      const auto d = Reader{path}.numbers(motion, "dwell", 2);
+      for (std::size_t i = 0; i < d.size(); i += 2) {
+        const double k = d[i];
+        if (k != std::floor(k) || k < 0 || k >= static_cast<double>(s.waypoints.size()))
+          r.fail("motion.dwell", "waypoint index " + std::to_string(k) + " is not one of the waypoints");
+        if (!(d[i + 1] > 0) || d[i + 1] > 3600) r.fail("motion.dwell", "seconds must be in (0, 3600]");
+        s.dwell[static_cast<std::size_t>(k)] = d[i + 1];
+      }
+    }
   }
 
   const cv::FileNode objects = root["objects"];

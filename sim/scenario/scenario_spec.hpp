@@ -41,6 +41,7 @@ struct ScenarioSpec {
   std::string profile = "drone";  ///< car | drone | handheld
   double cruise_speed = 0;        ///< [m/s]; 0 = the profile's
   std::vector<Eigen::Vector3d> waypoints;
+  std::vector<double> dwell;  ///< per waypoint: stand still there this long [s] (0: drive through)
   // ... or recorded motion: a TUM trajectory (e.g. EuRoC ground truth) fitted and placed in the street,
   // so the sim also runs the roll, pitch and shake of a real platform (motion.tum instead of waypoints).
   std::string tum_file;     ///< resolved path of motion.tum; empty = waypoints

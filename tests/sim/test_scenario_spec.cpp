@@ -3,6 +3,7 @@
 
 #include <catch2/catch.hpp>
 
+#include "sim/scenario/scenario.hpp"
 #include "sim/scenario/scenario_spec.hpp"
 
 using namespace dynavins::sim;
@@ -82,4 +83,28 @@ TEST_CASE("load_scenario: a wrong, unknown or missing key is an error naming key
   p = write_yaml("wp.yaml", "name: t\nmotion: { waypoints: [0, 0, 1.5, 50, 0] }\n");
   CHECK_THROWS_WITH(load_scenario(p), Catch::Contains("groups of 3"));
   CHECK_THROWS_WITH(load_scenario("/nonexistent/s.yaml"), Catch::Contains("/nonexistent/s.yaml"));
+}
+
+TEST_CASE("load_scenario: motion.dwell stops the path at a waypoint for that long", "[scenario]") {
+  const std::string motion = "motion: { profile: car, cruise_speed: 3, waypoints: [0, 0, 1.5, 12, 0, 1.5, 24, 0, 1.5]";
+  const auto path = write_yaml("dwell.yaml", "name: t\n" + motion + ", dwell: [1, 20] }\n");
+  const ScenarioSpec s = load_scenario(path);
+  REQUIRE(s.dwell.size() == 3);
+  CHECK(s.dwell[1] == 20.0);
+  CHECK(s.dwell[0] == 0.0);
+  const ScenarioSpec plain = load_scenario(write_yaml("nodwell.yaml", "name: t\n" + motion + " }\n"));
+  const auto with = build_body_trajectory(s), without = build_body_trajectory(plain);
+  // The stop adds its 20 s (and the braking and starting a corner stop costs).
+  CHECK(with->duration() > without->duration() + 20.0);
+  // Somewhere in the middle the body stands at the second waypoint.
+  const double mid = with->t_min() + 0.5 * with->duration();
+  CHECK(with->velocity(mid).norm() < 1e-3);
+  CHECK((with->position(mid) - Eigen::Vector3d(12, 0, 1.5)).norm() < 0.5);
+
+  auto p = write_yaml("dwell_idx.yaml", "name: t\n" + motion + ", dwell: [3, 5] }\n");
+  CHECK_THROWS_WITH(load_scenario(p), Catch::Contains("motion.dwell: waypoint index"));
+  p = write_yaml("dwell_len.yaml", "name: t\n" + motion + ", dwell: [1, -5] }\n");
+  CHECK_THROWS_WITH(load_scenario(p), Catch::Contains("motion.dwell: seconds must be"));
+  p = write_yaml("dwell_odd.yaml", "name: t\n" + motion + ", dwell: [1] }\n");
+  CHECK_THROWS_WITH(load_scenario(p), Catch::Contains("dwell"));
 }
