@@ -96,7 +96,7 @@ void write_logs(const Clip& c, const fs::path& dir) {
       pipeline::write_sensor_event(log, f, encoding);
     }
     // A channel the source skips and counts.
-    log.write(channels::kImu + std::string("_OTHER"), 1, pipeline::to_lcm(c.imu.front()));
+    log.write(pipeline::channels::kImu + std::string("_OTHER"), 1, pipeline::to_lcm(c.imu.front()));
     log.close();
   }
 }
