@@ -2,6 +2,7 @@
 
 #include <cmath>
 #include <filesystem>
+#include <fstream>
 #include <set>
 
 #include <opencv2/core.hpp>
@@ -26,10 +27,27 @@ std::string first_word(const std::string& s) {
   return s.substr(b, e == std::string::npos ? std::string::npos : e - b);
 }
 
+// OpenCV 4.6's yaml parser never returns from some files with a second %YAML directive after a "---"
+// (found by fuzz_camera: "%YAML:1.0\n---k%YAML:1.0\n--d-\n" loops forever inside FileStorage::open).
+// The directive belongs on the first line of a VINS-Fusion / OpenCV config, so anywhere else it is
+// refused before the parser sees it. Returns the 1-based line of the first misplaced one, 0 if none.
+int misplaced_yaml_directive(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  std::string line;
+  for (int n = 1; std::getline(in, line); ++n) {
+    const auto at = line.find("%YAML");
+    if (at != std::string::npos && (n > 1 || at > 0)) return n;
+  }
+  return 0;
+}
+
 }  // namespace
 
 ConfigReader::ConfigReader(const std::string& path) : path_(path) {
   if (!std::filesystem::is_regular_file(path)) throw ConfigError(path, "", "file not found");
+  if (const int line = misplaced_yaml_directive(path))
+    throw ConfigError(path, "", "line " + std::to_string(line) +
+                                    ": a %YAML directive belongs at the start of the first line only");
   try {
     fs_.open(path, cv::FileStorage::READ);
   } catch (const cv::Exception& e) {
