@@ -53,7 +53,8 @@ cv::Mat image_from_lcm(const dynavins_lcm::image_t& msg) {
   if (msg.size != static_cast<int32_t>(msg.data.size()))
     throw std::runtime_error("image_t.size does not match its data");
   if (msg.encoding == dynavins_lcm::image_t::ENCODING_GRAY8) {
-    if (static_cast<int64_t>(msg.width) * msg.height != msg.size)
+    // Both positive: -2 x -3 also makes 6 bytes (found by fuzz_lcm_decode: OpenCV asserted in Mat::create).
+    if (msg.width <= 0 || msg.height <= 0 || static_cast<int64_t>(msg.width) * msg.height != msg.size)
       throw std::runtime_error("image_t: gray8 data of " + std::to_string(msg.size) + " bytes for " +
                                std::to_string(msg.width) + "x" + std::to_string(msg.height));
     return cv::Mat(msg.height, msg.width, CV_8UC1, const_cast<uint8_t*>(msg.data.data())).clone();

@@ -70,6 +70,8 @@ TEST_CASE("image_t with inconsistent data is rejected with the field named", "[l
   auto msg = image_to_lcm(test_image(1), 0, ImageEncoding::Gray8);
   msg.width = 10;
   CHECK_THROWS_WITH(image_from_lcm(msg), Catch::Contains("gray8 data"));
+  msg.width = -64, msg.height = -48;  // test_image is 64 x 48: the product of the negated sizes still matches
+  CHECK_THROWS_WITH(image_from_lcm(msg), Catch::Contains("gray8 data"));
   auto png = image_to_lcm(test_image(1), 0, ImageEncoding::Png);
   png.data[20] ^= 0xff;
   png.data.resize(40);
