@@ -3,7 +3,7 @@
 # (`run --rate R`: frames are dropped oldest first when the tracker falls behind, IMU never is), at each
 # RATE, REPS times, and rate 0 (lossless) once as the reference. Reports, per rate, from summary.json:
 # frames in / dropped / estimated, IMU samples received of those in the log and the IMU queue's drops,
-# resets, tracking share, peak RSS and ATE. Writes bench/results/overload.md.
+# resets, tracking share, peak RSS and ATE. Writes bench/results/overload_<scene>.md.
 # Usage: bench/overload_bench.sh [SCENE_DIR] [REPS] [RATE ...]   (default: bench/cache/high-20s 3 1 2 5 10)
 set -euo pipefail
 args="$*"
@@ -13,7 +13,7 @@ shift $(( $# > 2 ? 2 : $# ))
 rates=("$@")
 [ ${#rates[@]} -eq 0 ] && rates=(1 2 5 10)
 bin=$(readlink -f "${DYNAVINS:-build/bin/dynavins}")
-out=$(readlink -f bench/results)/overload.md
+out=$(readlink -f bench/results)/overload_$(basename "$scene").md
 [ -d "$scene/euroc" ] || { echo "no $scene/euroc (scripts/cached-sim.sh high --euroc --duration 20 with CACHE_AS=high-20s)"; exit 2; }
 tmp=$(mktemp -d)
 trap 'rm -rf "$tmp"' EXIT
