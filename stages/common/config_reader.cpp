@@ -27,27 +27,32 @@ std::string first_word(const std::string& s) {
   return s.substr(b, e == std::string::npos ? std::string::npos : e - b);
 }
 
-// OpenCV 4.6's yaml parser never returns from some files with a second %YAML directive after a "---"
-// (found by fuzz_camera: "%YAML:1.0\n---k%YAML:1.0\n--d-\n" loops forever inside FileStorage::open).
-// The directive belongs on the first line of a VINS-Fusion / OpenCV config, so anywhere else it is
-// refused before the parser sees it. Returns the 1-based line of the first misplaced one, 0 if none.
-int misplaced_yaml_directive(const std::string& path) {
+// OpenCV 4.6's yaml parser never returns from some files with junk after a "---" document marker (found
+// by fuzz_camera: "%YAML:1.0\n---k%YAML:1.0\n--d-\n" and "%YAML:1.0\n---*m%Y]AML:1.0\n--\n-mo\n" loop
+// forever inside FileStorage::open). A VINS-Fusion / OpenCV config has its %YAML directive at the start of
+// the first line and "---" alone on its line, so anything else there is refused before the parser sees
+// it. Returns what is wrong, with its 1-based line, or an empty string.
+std::string parser_trap(const std::string& path) {
   std::ifstream in(path, std::ios::binary);
   std::string line;
   for (int n = 1; std::getline(in, line); ++n) {
     const auto at = line.find("%YAML");
-    if (at != std::string::npos && (n > 1 || at > 0)) return n;
+    if (at != std::string::npos && (n > 1 || at > 0))
+      return "line " + std::to_string(n) + ": a %YAML directive belongs at the start of the first line only";
+    if (line.rfind("---", 0) == 0) {
+      const auto rest = line.find_first_not_of(" \t\r", 3);
+      if (rest != std::string::npos && line[rest] != '#')
+        return "line " + std::to_string(n) + ": the document marker --- must stand alone on its line";
+    }
   }
-  return 0;
+  return {};
 }
 
 }  // namespace
 
 ConfigReader::ConfigReader(const std::string& path) : path_(path) {
   if (!std::filesystem::is_regular_file(path)) throw ConfigError(path, "", "file not found");
-  if (const int line = misplaced_yaml_directive(path))
-    throw ConfigError(path, "", "line " + std::to_string(line) +
-                                    ": a %YAML directive belongs at the start of the first line only");
+  if (const std::string trap = parser_trap(path); !trap.empty()) throw ConfigError(path, "", trap);
   try {
     fs_.open(path, cv::FileStorage::READ);
   } catch (const cv::Exception& e) {

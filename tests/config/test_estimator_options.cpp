@@ -234,7 +234,7 @@ TEST_CASE("Errors name the key and the file", "[options][errors]") {
     CHECK_THROWS_AS(ConfigReader(cam), ConfigError);
     CHECK_THROWS_WITH(ConfigReader(cam), Catch::Contains(cam) && Catch::Contains("not a valid OpenCV yaml file"));
   }
-  SECTION("a second %YAML directive is refused, naming file and line, before OpenCV's parser loops on it") {
+  SECTION("a second %YAML directive or junk after ---: refused, naming file and line, before OpenCV loops on it") {
     // Found by fuzz_camera (tests/data/fuzz_regressions/camera/): FileStorage::open never returned.
     const std::string cam =
         (fs::path(DYNAVINS_SOURCE_DIR) / "tests/data/fuzz_regressions/camera/opencv_parser_hang_second_directive.yaml")
@@ -243,6 +243,10 @@ TEST_CASE("Errors name the key and the file", "[options][errors]") {
     const std::string path = (s.dir / "late_directive.yaml").string();
     std::ofstream(path) << "# a comment first\n%YAML:1.0\nimage_width: 752\n";
     CHECK_THROWS_WITH(EstimatorOptions::load(path), Catch::Contains(path) && Catch::Contains("line 2"));
+    const std::string junk =
+        (fs::path(DYNAVINS_SOURCE_DIR) / "tests/data/fuzz_regressions/camera/opencv_parser_hang_junk_after_marker.yaml")
+            .string();
+    CHECK_THROWS_WITH(ConfigReader(junk), Catch::Contains(junk) && Catch::Contains("line 2: the document marker ---"));
   }
   SECTION("a yaml whose top level is a sequence names the file (OpenCV asserted in its key lookup)") {
     const std::string path = (s.dir / "sequence.yaml").string();
