@@ -39,6 +39,11 @@ std::string parser_trap(const std::string& path) {
     const auto at = line.find("%YAML");
     if (at != std::string::npos && (n > 1 || at > 0))
       return "line " + std::to_string(n) + ": a %YAML directive belongs at the start of the first line only";
+    // An empty key ("   : camera"): OpenCV read out of bounds on it (found by fuzz_camera: std::length_error
+    // in a Release build, SEGV inside OpenCV under ThreadSanitizer).
+    const auto first = line.find_first_not_of(" \t");
+    if (first != std::string::npos && line[first] == ':')
+      return "line " + std::to_string(n) + ": a key is missing before ':'";
     if (line.rfind("---", 0) == 0) {
       const auto rest = line.find_first_not_of(" \t\r", 3);
       if (rest != std::string::npos && line[rest] != '#')
