@@ -3,7 +3,6 @@
 // both cameras go black for 2 s, then a burst of frames never arrives, then the IMU biases jump. What a
 // robot needs from the estimate through all this: no NaN, no silent jump of the pose (a discontinuity is
 // only allowed where a reset is reported, with its reason), and tracking again once the images are back.
-#include <cmath>
 #include <string>
 #include <vector>
 
