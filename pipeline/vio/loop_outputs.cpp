@@ -57,7 +57,7 @@ LoopTruthCounts write_loops_csv(const std::string& path, const LoopRunSummary& l
       const double err_deg = truth_mq.q.angularDistance(l.q_mq) * 180.0 / M_PI;
       const bool is_true = err_m < kTrueLoopMaxErrorM && err_deg < kTrueLoopMaxErrorDeg;
       (is_true ? c.true_loops : c.false_loops)++;
-      if (!is_true && r.used && r.weight >= 0.5) ++c.false_used;
+      if (r.used && r.weight >= 0.5) ++(is_true ? c.true_used : c.false_used);
       f << ',' << (is_true ? 1 : 0) << ',' << err_m << ',' << err_deg << '\n';
     } else {
       f << ",,,\n";
@@ -80,7 +80,7 @@ std::string loop_json(const LoopRunSummary& l, const LoopTruthCounts& t, bool ha
     << ", \"optimization_ms_max\": " << l.optimization_ms_max << ", \"memory_kb\": " << l.memory_bytes / 1024.0;
   if (has_truth)
     j << ", \"true_loops\": " << t.true_loops << ", \"false_loops\": " << t.false_loops
-      << ", \"false_loops_used\": " << t.false_used;
+      << ", \"false_loops_used\": " << t.false_used << ", \"true_loops_used\": " << t.true_used;
   j << "}";
   return j.str();
 }

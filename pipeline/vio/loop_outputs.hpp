@@ -22,6 +22,7 @@ inline constexpr double kTrueLoopMaxErrorM = 0.3, kTrueLoopMaxErrorDeg = 5.0;
 struct LoopTruthCounts {
   int true_loops = 0, false_loops = 0;
   int false_used = 0;  ///< false loops the final optimisation used with weight >= 0.5
+  int true_used = 0;   ///< true loops the final optimisation used with weight >= 0.5
 };
 
 /// Writes loops.csv to `path`; `truth` may be empty (no ground truth: the truth columns stay empty).
