@@ -73,3 +73,43 @@ TEST_CASE("street twins: the robust BA keeps the static street and holds in the 
   CHECK(dyn_crowd.ate <= kDegradationBound * dyn_still.ate);
   CHECK((hub_crowd.run.resets > 0 || dyn_crowd.ate <= kHuberRatio * hub_crowd.ate));
 }
+
+TEST_CASE("mono initialises behind a truck that leads the camera", "[vio][dynamic][street][mono]") {
+  // bench/scenarios/street_follow.yaml and its static twin, first 6 s: the car starts from rest at
+  // t = 1 s and reaches 3 m/s; a box truck's rear stays ~3 m ahead, about half the image. Its features
+  // keep their pixels while the camera drives, so averaged into VINS-Fusion's parallax test they kept
+  // the mono initialisation from ever succeeding (38 s, 0 % tracking; issue 23). Judged on the features
+  // that move in the image (MonoSfmOptions::min_feature_motion_px), it initialises as soon as the static
+  // twin does. Measured when written: both at t = 2.8 s; path length / true 1.034 behind the truck,
+  // 1.042 in the twin (bound: 10 %).
+  const auto first_6s = [](const std::string& name) {
+    return sim::build_scenario(
+        sim::load_scenario(std::string(DYNAVINS_SOURCE_DIR) + "/bench/scenarios/" + name + ".yaml"), std::nullopt,
+        6.0);
+  };
+  const Outcome twin = test::run_scene(first_6s("street_follow_none"), estimator::BaLoss::Dynavins, false);
+  const Outcome truck = test::run_scene(first_6s("street_follow"), estimator::BaLoss::Dynavins, false);
+  REQUIRE_FALSE(twin.run.estimate.poses.empty());
+  REQUIRE_FALSE(truck.run.estimate.poses.empty());
+  const double t0 = 1e-9 * static_cast<double>(truck.true_speed.begin()->first);
+  const double twin_init = 1e-9 * static_cast<double>(twin.run.estimate.poses.front().t_ns) - t0;
+  const double truck_init = 1e-9 * static_cast<double>(truck.run.estimate.poses.front().t_ns) - t0;
+  // Scale after initialisation (the first 6 s are a straight line, too degenerate for an aligned ATE):
+  // the estimated path length against the true one over the same frames.
+  const auto length_ratio = [](const Outcome& o) {
+    double est = 0.0, truth = 0.0;
+    const auto& p = o.run.estimate.poses;
+    for (std::size_t i = 1; i < p.size(); ++i) {
+      est += (p[i].p - p[i - 1].p).norm();
+      const auto v = o.true_speed.lower_bound(p[i].t_ns);
+      if (v != o.true_speed.end()) truth += v->second * 1e-9 * static_cast<double>(p[i].t_ns - p[i - 1].t_ns);
+    }
+    return est / truth;
+  };
+  const double truck_scale = length_ratio(truck), twin_scale = length_ratio(twin);
+  INFO("initialised at t = " << truck_init << " s behind the truck, " << twin_init << " s in the static twin; "
+                             << "path length / true " << truck_scale << " / " << twin_scale);
+  CHECK(truck.run.resets == 0);
+  CHECK(truck_init <= twin_init + 1.0);
+  CHECK(std::abs(truck_scale - 1.0) < 0.1);
+}

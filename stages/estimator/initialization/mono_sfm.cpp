@@ -4,6 +4,7 @@
 #include <array>
 #include <cmath>
 #include <cstdio>
+#include <set>
 #include <string>
 
 #include <ceres/ceres.h>
@@ -56,6 +57,18 @@ Correspondences correspondences(const FrameFeatures& fa, const FrameFeatures& fb
     c.b.push_back(it->second);
   }
   return c;
+}
+
+// The correspondences whose image motion is at least min_motion_px (MonoSfmOptions::min_feature_motion_px).
+Correspondences moved_in_image(const Correspondences& c, double min_motion_px, double focal) {
+  Correspondences m;
+  for (size_t i = 0; i < c.a.size(); ++i) {
+    if (focal * (c.a[i] - c.b[i]).norm() < min_motion_px) continue;
+    m.ids.push_back(c.ids[i]);
+    m.a.push_back(c.a[i]);
+    m.b.push_back(c.b[i]);
+  }
+  return m;
 }
 
 double mean_parallax_px(const Correspondences& c, double focal) {
@@ -111,19 +124,27 @@ class SfmBuilder {
   const MonoSfmOptions& o_;
   std::vector<CameraPose> poses_;
   std::map<FeatureId, Eigen::Vector3d> points_;
+  /// Features common to l and the newest frame that moved less than min_feature_motion_px between them:
+  /// at infinity or moving with the camera, never triangulated (they would enter the BA as outliers).
+  std::set<FeatureId> still_;
   double rms_px_ = 0.0;
   int reference_ = 0;
 };
 
 bool SfmBuilder::choose_reference_frame(int& l, Eigen::Matrix3d& R, Eigen::Vector3d& t, std::string& why) const {
   const int newest = static_cast<int>(frames_.size()) - 1;
-  int best_common = 0;
+  int best_common = 0, best_moved = 0;
   double best_parallax = 0.0, best_translation_parallax = 0.0;
   for (int i = 0; i < newest; ++i) {
-    const Correspondences c = correspondences(frames_[i], frames_[newest]);
-    const int n = static_cast<int>(c.ids.size());
+    const Correspondences all = correspondences(frames_[i], frames_[newest]);
+    const int n = static_cast<int>(all.ids.size());
     best_common = std::max(best_common, n);
     if (n < o_.min_common_features) continue;
+    // Parallax, pure-rotation test and essential matrix on the features that moved (see the option).
+    const Correspondences c = moved_in_image(all, o_.min_feature_motion_px, o_.focal_px);
+    const int moved = static_cast<int>(c.ids.size());
+    best_moved = std::max(best_moved, moved);
+    if (moved < o_.min_common_features) continue;
     const double parallax = mean_parallax_px(c, o_.focal_px);
     best_parallax = std::max(best_parallax, parallax);
     if (parallax < o_.min_parallax_px) continue;
@@ -143,8 +164,12 @@ bool SfmBuilder::choose_reference_frame(int& l, Eigen::Matrix3d& R, Eigen::Vecto
   if (best_common < o_.min_common_features) {
     why = "no reference frame: at most " + std::to_string(best_common) + " common features with the newest frame (need " +
           std::to_string(o_.min_common_features) + ")";
+  } else if (best_moved < o_.min_common_features) {
+    why = "not enough parallax: at most " + std::to_string(best_moved) + " common features moved " +
+          num(o_.min_feature_motion_px) + " px or more (need " + std::to_string(o_.min_common_features) +
+          "); the camera has not moved enough, or what it sees moves with it";
   } else if (best_parallax < o_.min_parallax_px) {
-    why = "not enough parallax: at most " + num(best_parallax) + " px mean feature motion across the window (need " +
+    why = "not enough parallax: at most " + num(best_parallax) + " px mean motion of the features that moved (need " +
           num(o_.min_parallax_px) + "); the camera has not moved enough";
   } else if (best_translation_parallax < o_.min_translation_parallax_px) {
     why = "motion close to a pure rotation: at most " + num(best_translation_parallax) +
@@ -159,7 +184,7 @@ void SfmBuilder::triangulate_pair(int a, int b) {
   const Correspondences c = correspondences(frames_[a], frames_[b]);
   const CameraPose &A = poses_[a], &B = poses_[b];
   for (size_t i = 0; i < c.ids.size(); ++i) {
-    if (points_.count(c.ids[i])) continue;
+    if (points_.count(c.ids[i]) || still_.count(c.ids[i])) continue;
     Eigen::Vector3d p;
     if (triangulate_two_views(A.q_cw.toRotationMatrix(), A.t_cw, c.a[i], B.q_cw.toRotationMatrix(), B.t_cw, c.b[i], p))
       points_[c.ids[i]] = p;
@@ -221,7 +246,7 @@ void SfmBuilder::triangulate_remaining() {
       else it->second.second = k;
     }
   for (const auto& [id, fl] : span) {
-    if (points_.count(id) || fl.first == fl.second) continue;
+    if (points_.count(id) || still_.count(id) || fl.first == fl.second) continue;
     const CameraPose &A = poses_[fl.first], &B = poses_[fl.second];
     Eigen::Vector3d p;
     if (triangulate_two_views(A.q_cw.toRotationMatrix(), A.t_cw, frames_[fl.first].at(id), B.q_cw.toRotationMatrix(),
@@ -352,6 +377,9 @@ MonoSfmResult SfmBuilder::run() {
   Eigen::Vector3d t;
   if (!choose_reference_frame(l, R, t, res.reason)) return res;
   reference_ = l;
+  const Correspondences common = correspondences(frames_[l], frames_[newest]);
+  for (size_t i = 0; i < common.ids.size(); ++i)
+    if (o_.focal_px * (common.a[i] - common.b[i]).norm() < o_.min_feature_motion_px) still_.insert(common.ids[i]);
   poses_[newest].q_cw = Eigen::Quaterniond(R);  // x_newest = R x_l + t is the world(l)-to-camera map
   poses_[newest].t_cw = t;
 
