@@ -18,4 +18,11 @@ namespace dynavins::estimator {
 Eigen::Vector3d estimate_gyro_bias(const std::vector<Eigen::Matrix3d>& R_wb,
                                  const std::vector<const imu::ImuPreintegration*>& preints);
 
+/// What the fit leaves unexplained: the RMS over the intervals of || Log(γ^-1 ⊗ q_bk^-1 ⊗ q_bk+1) − J δbg ||
+/// [rad]. Small when one constant bias reconciles the visual rotations with the gyroscope; large when the
+/// visual rotations are wrong (a view that moves as a whole, wrong images), which no bias can explain.
+/// Same arguments as estimate_gyro_bias plus its result; 0 when there is no interval.
+double gyro_bias_fit_rms_rad(const std::vector<Eigen::Matrix3d>& R_wb,
+                             const std::vector<const imu::ImuPreintegration*>& preints, const Eigen::Vector3d& dbg);
+
 }  // namespace dynavins::estimator
