@@ -69,15 +69,19 @@ NS
 grep -q '"lcm": {"url"' live/summary.json || { echo "FAIL: live/summary.json has no lcm section"; exit 1; }
 # Every frame that arrived is either tracked or counted as dropped (real time drops the oldest when the
 # tracker falls behind); at least 80 % are estimated on a machine that is not overloaded.
-python3 - <<'PY' || exit 1
+# DYNAVINS_LIVE_MIN_ESTIMATED lowers that floor for builds too slow for real time (AddressSanitizer: about
+# 2-3x slower, so the real-time policy drops more; what that pass checks is memory, not throughput).
+python3 - "${DYNAVINS_LIVE_MIN_ESTIMATED:-145}" <<'PY' || exit 1
 import json, sys
+min_estimated = int(sys.argv[1])
 s = json.load(open("live/summary.json"))
 print(f"live: {s['frames_in']} frames in, {s['frames_tracked']} tracked, {s['frames_dropped']} dropped, "
       f"{s['frames_estimated']} estimated, real-time threads {s.get('realtime_threads')}")
 if s["frames_tracked"] + s["frames_dropped"] != s["frames_in"]:
     sys.exit("FAIL: frames in != tracked + dropped")
-if s["frames_estimated"] < 145:
-    sys.exit(f"FAIL: live estimated {s['frames_estimated']} of 181 frames (UDP loss? check net.core.rmem_max)")
+if s["frames_estimated"] < min_estimated:
+    sys.exit(f"FAIL: live estimated {s['frames_estimated']} of 181 frames, need {min_estimated} "
+             "(UDP loss? check net.core.rmem_max)")
 PY
 check_outputs out-live.lcm live
 check_outputs out-run.lcm run
