@@ -3,14 +3,16 @@
 # machine is shared), one after the other, from a seed corpus made of real inputs (make_fuzz_seeds).
 #   scripts/fuzz.sh <fuzz build dir> [harness ...]     (default: every harness)
 # Per harness, in <build>/fuzz-runs/<name>/: corpus/ (seeds + what libFuzzer adds), crash-* files,
-# log.txt. A summary line per harness (executions, cov, ft, seconds, result) goes to
-# <build>/fuzz-runs/summary.md. Exit status 1 if any harness found a crash.
+# log.txt, row.md. Each harness's latest row (finished at, executions, cov, ft, seconds, result) is kept in its
+# row.md, and <build>/fuzz-runs/summary.md is rebuilt from every harness's row, so a call that runs only
+# some harnesses keeps the others' last results. Exit status 1 if any harness found a crash.
 # A crash input belongs in tests/data/fuzz_regressions/<name>/ once the bug is fixed.
 set -uo pipefail
 BUILD=${1:?usage: scripts/fuzz.sh <fuzz build dir> [harness ...]}
 shift
 HARNESSES=("$@")
-[ ${#HARNESSES[@]} -eq 0 ] && HARNESSES=(lcm_log lcm_decode euroc_csv config camera rosbag)
+ALL=(lcm_log lcm_decode euroc_csv config camera rosbag)
+[ ${#HARNESSES[@]} -eq 0 ] && HARNESSES=("${ALL[@]}")
 SECONDS_EACH=${FUZZ_SECONDS:-600}
 ROOT=$(cd "$(dirname "$0")/.." && pwd)
 SHARED=${DYNAVINS_SHARED:-$ROOT/../shared}/data
@@ -26,8 +28,6 @@ export ASAN_OPTIONS="detect_leaks=1:allocator_may_return_null=0:${ASAN_OPTIONS:-
 export UBSAN_OPTIONS="print_stacktrace=1:halt_on_error=1"
 status=0
 summary=$RUNS/summary.md
-echo "| harness | seconds | executions | cov | ft | corpus | result |" >"$summary"
-echo "| --- | --- | --- | --- | --- | --- | --- |" >>"$summary"
 for h in "${HARNESSES[@]}"; do
   dir=$RUNS/$h
   mkdir -p "$dir/corpus" "$dir/artifacts"
@@ -51,7 +51,14 @@ for h in "${HARNESSES[@]}"; do
     result="FOUND: $(ls "$dir/artifacts" | head -3 | tr '\n' ' ')(see $dir/log.txt)"
     status=1
   fi
-  echo "| $h | $secs | $execs | $cov | $ft | $corp | $result |" | tee -a "$summary"
+  echo "| $h | $(date -u +%Y-%m-%dT%H:%MZ) | $secs | $execs | $cov | $ft | $corp | $result |" | tee "$dir/row.md"
 done
+{
+  echo "| harness | finished (UTC) | seconds | executions | cov | ft | corpus | result |"
+  echo "| --- | --- | --- | --- | --- | --- | --- | --- |"
+  for h in "${ALL[@]}"; do
+    [ -f "$RUNS/$h/row.md" ] && cat "$RUNS/$h/row.md"
+  done
+} >"$summary"
 echo "fuzz: summary in $summary"
 exit $status
