@@ -15,6 +15,7 @@
 #include <dynavins_lcm/path_t.hpp>
 #include <dynavins_lcm/pipeline_stats_t.hpp>
 #include <dynavins_lcm/pose_t.hpp>
+#include <dynavins_lcm/status_t.hpp>
 #include <dynavins_lcm/stereo_image_t.hpp>
 #include <dynavins_lcm/weighted_feature_set_t.hpp>
 
@@ -49,7 +50,7 @@ void run_log_info(const std::string& path) {
   const auto types = known_types<dynavins_lcm::stereo_image_t, dynavins_lcm::imu_t, dynavins_lcm::ground_truth_t,
                                  dynavins_lcm::image_t, dynavins_lcm::pose_t, dynavins_lcm::weighted_feature_set_t,
                                  dynavins_lcm::loop_hypotheses_t, dynavins_lcm::path_t,
-                                 dynavins_lcm::pipeline_stats_t>();
+                                 dynavins_lcm::pipeline_stats_t, dynavins_lcm::status_t>();
   std::map<std::string, ChannelSummary> channels;
   int64_t total = 0;
   pipeline::LogChecksumStats checksums;
