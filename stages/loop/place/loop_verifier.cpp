@@ -8,6 +8,8 @@
 #include <opencv2/calib3d.hpp>
 #include <opencv2/core/eigen.hpp>
 
+#include "stages/loop/place/two_way_refinement.hpp"
+
 namespace dynavins::loop {
 
 const char* to_string(LoopRejection r) {
@@ -76,6 +78,27 @@ LoopVerification LoopVerifier::verify(const KeyframeDescriptors& query, const Ke
   Eigen::Vector3d t_kc_mc;
   cv::cv2eigen(R_cv, R_kc_mc);
   cv::cv2eigen(tvec, t_kc_mc);
+  if (opts_.two_way_refinement && static_cast<int>(inliers.size()) >= opts_.min_inliers) {
+    // The query camera C_k in its own odometry world frame, for its points.
+    const Eigen::Quaterniond q_wck = (query.q_wb * query.q_bc).normalized();
+    const Eigen::Vector3d p_wck = query.p_wb + query.q_wb * query.p_bc;
+    std::vector<TwoWayCorrespondence> c;
+    c.reserve(inliers.size());
+    for (const int i : inliers) {
+      const DescriptorMatch& m = matches[static_cast<std::size_t>(i)];
+      TwoWayCorrespondence x;
+      x.p_m = Eigen::Vector3d(object[i].x, object[i].y, object[i].z);
+      x.xy_k = query.points[m.query].xy;
+      x.xy_m = match.points[m.match].xy;
+      x.has_p_k = query.points[m.query].has_p_w && x.xy_m.allFinite();
+      if (x.has_p_k) x.p_k = q_wck.conjugate() * (query.points[m.query].p_w - p_wck);
+      c.push_back(x);
+    }
+    Eigen::Quaterniond q_km(R_kc_mc);
+    TwoWayRefinementOptions ro;
+    ro.focal_px = opts_.focal_px;
+    if (refine_two_way(c, q_km, t_kc_mc, ro)) R_kc_mc = q_km.toRotationMatrix();
+  }
   const Eigen::Quaterniond q_mc_kc(R_kc_mc.transpose());
   const Eigen::Vector3d p_mc_kc = -(R_kc_mc.transpose() * t_kc_mc);
   const Eigen::Quaterniond q_kc_kb = query.q_bc.conjugate();

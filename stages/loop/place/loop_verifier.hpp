@@ -21,6 +21,7 @@ struct LoopVerifierOptions {
   int min_inliers = 15;             // DESIGN.md §3
   double max_translation_m = 10.0;  // |p_mq| above this is implausible for a revisit seen by the same camera
   double max_rotation_deg = 45.0;   // rotation angle of q_mq above this is implausible (VINS-Mono: 30 deg yaw)
+  bool two_way_refinement = true;   // refine PnP's pose with the query's own 3-D points too (two_way_refinement.hpp)
 };
 
 enum class LoopRejection { None, TooFewMatches, PnpFailed, TooFewInliers, Implausible };
