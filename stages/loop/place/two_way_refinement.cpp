@@ -5,15 +5,20 @@
 namespace dynavins::loop {
 namespace {
 
+// r = focal * (π(x) − xy), in pixels.
+template <typename T>
+void reprojection_px(const Eigen::Matrix<T, 3, 1>& x, const Eigen::Vector2d& xy, double focal, T* r) {
+  r[0] = T(focal) * (x.x() / x.z() - T(xy.x()));
+  r[1] = T(focal) * (x.y() / x.z() - T(xy.y()));
+}
+
 // A match point seen by the query camera: π(q_km p_m + t_km) − xy_k.
 struct MatchPointInQuery {
   template <typename T>
   bool operator()(const T* q, const T* t, T* r) const {
     const Eigen::Map<const Eigen::Quaternion<T>> q_km(q);
     const Eigen::Map<const Eigen::Matrix<T, 3, 1>> t_km(t);
-    const Eigen::Matrix<T, 3, 1> x = q_km * p_m.cast<T>() + t_km;
-    r[0] = T(focal) * (x.x() / x.z() - T(xy.x()));
-    r[1] = T(focal) * (x.y() / x.z() - T(xy.y()));
+    reprojection_px<T>(q_km * p_m.cast<T>() + t_km, xy, focal, r);
     return true;
   }
   Eigen::Vector3d p_m;
@@ -27,9 +32,7 @@ struct QueryPointInMatch {
   bool operator()(const T* q, const T* t, T* r) const {
     const Eigen::Map<const Eigen::Quaternion<T>> q_km(q);
     const Eigen::Map<const Eigen::Matrix<T, 3, 1>> t_km(t);
-    const Eigen::Matrix<T, 3, 1> x = q_km.conjugate() * (p_k.cast<T>() - t_km);
-    r[0] = T(focal) * (x.x() / x.z() - T(xy.x()));
-    r[1] = T(focal) * (x.y() / x.z() - T(xy.y()));
+    reprojection_px<T>(q_km.conjugate() * (p_k.cast<T>() - t_km), xy, focal, r);
     return true;
   }
   Eigen::Vector3d p_k;
