@@ -2,7 +2,8 @@
 // Geometric verification of a loop candidate (paper IV; DESIGN.md §3): the candidate's (match's) 3-D points,
 // moved into its camera frame with its pose and extrinsic, are matched by descriptor to the query's
 // undistorted normalised coordinates and fed to PnP RANSAC (cv::solvePnPRansac, identity K). At least 15
-// inliers and a plausible relative pose make a VerifiedLoop, whose T_m^k (eq. 13) is body to body.
+// inliers and a plausible relative pose make a VerifiedLoop, whose T_m^k (eq. 13) is body to body. The PnP
+// pose is refined over the inliers with the query's own 3-D points as well (two_way_refinement.hpp).
 
 #include <string>
 
