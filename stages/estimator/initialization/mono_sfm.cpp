@@ -59,11 +59,16 @@ Correspondences correspondences(const FrameFeatures& fa, const FrameFeatures& fb
   return c;
 }
 
-// The correspondences whose image motion is at least min_motion_px (MonoSfmOptions::min_feature_motion_px).
+// Whether correspondence i moved less than min_motion_px in the image (MonoSfmOptions::min_feature_motion_px).
+bool still_in_image(const Correspondences& c, size_t i, double min_motion_px, double focal) {
+  return focal * (c.a[i] - c.b[i]).norm() < min_motion_px;
+}
+
+// The correspondences that are not still_in_image.
 Correspondences moved_in_image(const Correspondences& c, double min_motion_px, double focal) {
   Correspondences m;
   for (size_t i = 0; i < c.a.size(); ++i) {
-    if (focal * (c.a[i] - c.b[i]).norm() < min_motion_px) continue;
+    if (still_in_image(c, i, min_motion_px, focal)) continue;
     m.ids.push_back(c.ids[i]);
     m.a.push_back(c.a[i]);
     m.b.push_back(c.b[i]);
@@ -379,7 +384,7 @@ MonoSfmResult SfmBuilder::run() {
   reference_ = l;
   const Correspondences common = correspondences(frames_[l], frames_[newest]);
   for (size_t i = 0; i < common.ids.size(); ++i)
-    if (o_.focal_px * (common.a[i] - common.b[i]).norm() < o_.min_feature_motion_px) still_.insert(common.ids[i]);
+    if (still_in_image(common, i, o_.min_feature_motion_px, o_.focal_px)) still_.insert(common.ids[i]);
   poses_[newest].q_cw = Eigen::Quaterniond(R);  // x_newest = R x_l + t is the world(l)-to-camera map
   poses_[newest].t_cw = t;
 
