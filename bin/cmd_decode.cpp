@@ -2,8 +2,9 @@
 // outputs (what `lcm-logger` captured of `run --lcm-url` or `live`), decodes every output channel, checks
 // what a subscriber relies on (every message decodes, poses finite with unit quaternions, weights in
 // [0, 1]) and prints per channel how many arrived and at what rate. With --out it writes the poses as TUM
-// files (pose.tum: window poses, pose_imu.tum: IMU-rate poses) that `dynavins eval` and evo read, and the
-// status changes as status.csv. Exit 1 when a check fails, 2 when the log cannot be read.
+// files (pose.tum: window poses, pose_imu.tum: IMU-rate poses) that `dynavins eval` and evo read, the
+// status changes as status.csv, and the pipeline's health reports over time as stats.csv (one row per
+// stage per report) and queues.csv (one row per queue per report), for plots of latency over a long run. Exit 1 when a check fails, 2 when the log cannot be read.
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
@@ -72,6 +73,14 @@ eval::StampedPose stamped(const dynavins_lcm::pose_t& m) {
   return eval::stamped_pose(m.utime * 1000, Eigen::Vector3d(m.position[0], m.position[1], m.position[2]), q);
 }
 
+/// Writes a header and rows; the stats' latencies are cumulative since the run started (as published).
+void write_csv(const std::string& path, const char* header, const std::vector<std::string>& rows) {
+  std::ofstream s(path);
+  s << header << "\n";
+  for (const auto& row : rows) s << row << "\n";
+  if (!s) throw CommandError("cannot write " + path, 2);
+}
+
 void run_decode(const DecodeOptions& o) {
   pipeline::PublisherChannels ch;
   try {
@@ -91,7 +100,7 @@ void run_decode(const DecodeOptions& o) {
   window.source = o.log + ":" + ch.pose;
   imu_rate.source = o.log + ":" + ch.pose_imu;
   corrected.source = o.log + ":" + ch.pose_corrected;
-  std::vector<std::string> status_rows;
+  std::vector<std::string> status_rows, stage_rows, queue_rows;
   int64_t features = 0, rejected = 0, other_events = 0;
   float w_min = 1.f, w_max = 0.f;
   Findings f;
@@ -135,6 +144,13 @@ void run_decode(const DecodeOptions& o) {
           const auto m = reader->decode<dynavins_lcm::pipeline_stats_t>(r);
           counts[r.channel].add(r.utime);  // stats carry wall-clock time
           if (m.num_stages == 0) f.fail(reader->where(r) + ": stats message lists no stage");
+          for (const auto& st : m.stages)
+            stage_rows.push_back(fmt::format("{:.3f},{:.4f},{},{},{},{},{},{},{}", m.wall_s, m.realtime_factor, st.name,
+                                             st.processed, st.process_ms_mean, st.process_ms_p95, st.process_ms_max,
+                                             st.wait_ms_mean, st.wait_ms_p95));
+          for (const auto& q : m.queues)
+            queue_rows.push_back(fmt::format("{:.3f},{},{},{},{},{},{},{}", m.wall_s, q.name, q.capacity, q.depth,
+                                             q.max_depth, q.pushed, q.delivered, q.dropped));
         } else {
           ++other_events;
         }
@@ -162,11 +178,13 @@ void run_decode(const DecodeOptions& o) {
     eval::write_tum(o.out + "/pose.tum", window);
     eval::write_tum(o.out + "/pose_imu.tum", imu_rate);
     if (!corrected.empty()) eval::write_tum(o.out + "/pose_corrected.tum", corrected);
-    std::ofstream s(o.out + "/status.csv");
-    s << "utime,status,frames,resets,reason\n";
-    for (const auto& row : status_rows) s << row << "\n";
-    if (!s) throw CommandError("cannot write " + o.out + "/status.csv", 2);
-    std::printf("outputs                 %s/pose.tum, pose_imu.tum, status.csv\n", o.out.c_str());
+    write_csv(o.out + "/status.csv", "utime,status,frames,resets,reason", status_rows);
+    write_csv(o.out + "/stats.csv",
+              "wall_s,realtime_factor,stage,processed,process_ms_mean,process_ms_p95,process_ms_max,wait_ms_mean,"
+              "wait_ms_p95",
+              stage_rows);
+    write_csv(o.out + "/queues.csv", "wall_s,queue,capacity,depth,max_depth,pushed,delivered,dropped", queue_rows);
+    std::printf("outputs                 %s/pose.tum, pose_imu.tum, status.csv, stats.csv, queues.csv\n", o.out.c_str());
   }
   if (!f.problems.empty()) {
     for (const auto& p : f.problems) std::fprintf(stderr, "decode: %s\n", p.c_str());
@@ -181,7 +199,7 @@ void add_decode_command(CLI::App& app) {
   auto* cmd = app.add_subcommand(
       "decode", "Decode a recording of DynaVINS' LCM outputs (lcm-logger): check it, count channels, write poses as TUM");
   cmd->add_option("--log", o->log, "LCM log recorded with lcm-logger")->required();
-  cmd->add_option("--out", o->out, "Write pose.tum, pose_imu.tum and status.csv here");
+  cmd->add_option("--out", o->out, "Write pose.tum, pose_imu.tum, status.csv, stats.csv and queues.csv here");
   cmd->add_option("--channel", o->channels, "Output channel name as given to run/live: --channel key=NAME");
   cmd->callback([o] { run_decode(*o); });
 }

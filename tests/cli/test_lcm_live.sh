@@ -34,6 +34,11 @@ PY
     n=$(awk -v k=$key '$2 == k {print $3}' "decode-$2.txt")
     [ "${n:-0}" -gt 0 ] || { echo "FAIL ($2): no $key messages"; exit 1; }
   done
+  # decode --out writes the stats over time: one row per stage (and per queue) per report
+  for f in stats queues; do
+    [ "$(wc -l < "dec-$2/$f.csv")" -gt 2 ] || { echo "FAIL ($2): dec-$2/$f.csv has no rows"; exit 1; }
+  done
+  grep -q ',estimator,' "dec-$2/stats.csv" || { head -3 "dec-$2/stats.csv"; echo "FAIL ($2): no estimator row in stats.csv"; exit 1; }
   "$bin" eval --gt scene/groundtruth.tum --est "dec-$2/pose.tum" --json "ate-$2.json" > /dev/null
   python3 - "ate-$2.json" "$ate_bound" <<'PY' || { echo "FAIL ($2): ATE above bound"; exit 1; }
 import json, sys
