@@ -117,7 +117,7 @@ class SfmBuilder {
   MonoSfmResult run();
 
  private:
-  bool choose_reference_frame(int& l, Eigen::Matrix3d& R, Eigen::Vector3d& t, std::string& why) const;
+  bool choose_reference_frame(int& l, Eigen::Matrix3d& R, Eigen::Vector3d& t, bool& riders, std::string& why) const;
   void triangulate_pair(int a, int b);
   bool solve_pn_p(int k, int guess_from, std::string& why);
   void triangulate_remaining();
@@ -129,14 +129,16 @@ class SfmBuilder {
   const MonoSfmOptions& o_;
   std::vector<CameraPose> poses_;
   std::map<FeatureId, Eigen::Vector3d> points_;
-  /// Features common to l and the newest frame that moved less than min_feature_motion_px between them:
-  /// at infinity or moving with the camera, never triangulated (they would enter the BA as outliers).
+  /// When riders were suspected at l (MonoSfmOptions::max_still_share): the features common to l and the
+  /// newest frame that moved less than min_feature_motion_px between them, never triangulated (they would
+  /// enter the BA as outliers). Empty otherwise.
   std::set<FeatureId> still_;
   double rms_px_ = 0.0;
   int reference_ = 0;
 };
 
-bool SfmBuilder::choose_reference_frame(int& l, Eigen::Matrix3d& R, Eigen::Vector3d& t, std::string& why) const {
+bool SfmBuilder::choose_reference_frame(int& l, Eigen::Matrix3d& R, Eigen::Vector3d& t, bool& riders,
+                                        std::string& why) const {
   const int newest = static_cast<int>(frames_.size()) - 1;
   int best_common = 0, best_moved = 0;
   double best_parallax = 0.0, best_translation_parallax = 0.0;
@@ -145,11 +147,14 @@ bool SfmBuilder::choose_reference_frame(int& l, Eigen::Matrix3d& R, Eigen::Vecto
     const int n = static_cast<int>(all.ids.size());
     best_common = std::max(best_common, n);
     if (n < o_.min_common_features) continue;
-    // Parallax, pure-rotation test and essential matrix on the features that moved (see the option).
-    const Correspondences c = moved_in_image(all, o_.min_feature_motion_px, o_.focal_px);
-    const int moved = static_cast<int>(c.ids.size());
-    best_moved = std::max(best_moved, moved);
-    if (moved < o_.min_common_features) continue;
+    // Too many still features to be far points alone: parallax, pure-rotation test and essential matrix
+    // on the features that moved (MonoSfmOptions::max_still_share).
+    const Correspondences moved_only = moved_in_image(all, o_.min_feature_motion_px, o_.focal_px);
+    const int moved = static_cast<int>(moved_only.ids.size());
+    const bool riders_here = n - moved > o_.max_still_share * n;
+    const Correspondences& c = riders_here ? moved_only : all;
+    best_moved = std::max(best_moved, static_cast<int>(c.ids.size()));
+    if (riders_here && moved < o_.min_common_features) continue;
     const double parallax = mean_parallax_px(c, o_.focal_px);
     best_parallax = std::max(best_parallax, parallax);
     if (parallax < o_.min_parallax_px) continue;
@@ -158,6 +163,7 @@ bool SfmBuilder::choose_reference_frame(int& l, Eigen::Matrix3d& R, Eigen::Vecto
     if (translation_parallax < o_.min_translation_parallax_px) continue;
     if (!relative_pose_from_essential(c, o_, R, t)) continue;
     l = i;
+    riders = riders_here;
     return true;
   }
   // Name the first test that no candidate frame passed (the tests run in this order).
@@ -174,7 +180,7 @@ bool SfmBuilder::choose_reference_frame(int& l, Eigen::Matrix3d& R, Eigen::Vecto
           num(o_.min_feature_motion_px) + " px or more (need " + std::to_string(o_.min_common_features) +
           "); the camera has not moved enough, or what it sees moves with it";
   } else if (best_parallax < o_.min_parallax_px) {
-    why = "not enough parallax: at most " + num(best_parallax) + " px mean motion of the features that moved (need " +
+    why = "not enough parallax: at most " + num(best_parallax) + " px mean feature motion (need " +
           num(o_.min_parallax_px) + "); the camera has not moved enough";
   } else if (best_translation_parallax < o_.min_translation_parallax_px) {
     why = "motion close to a pure rotation: at most " + num(best_translation_parallax) +
@@ -380,10 +386,11 @@ MonoSfmResult SfmBuilder::run() {
   int l = -1;
   Eigen::Matrix3d R;
   Eigen::Vector3d t;
-  if (!choose_reference_frame(l, R, t, res.reason)) return res;
+  bool riders = false;
+  if (!choose_reference_frame(l, R, t, riders, res.reason)) return res;
   reference_ = l;
   const Correspondences common = correspondences(frames_[l], frames_[newest]);
-  for (size_t i = 0; i < common.ids.size(); ++i)
+  for (size_t i = 0; riders && i < common.ids.size(); ++i)
     if (still_in_image(common, i, o_.min_feature_motion_px, o_.focal_px)) still_.insert(common.ids[i]);
   poses_[newest].q_cw = Eigen::Quaterniond(R);  // x_newest = R x_l + t is the world(l)-to-camera map
   poses_[newest].t_cw = t;
