@@ -50,6 +50,14 @@ TEST_CASE("Every scenario file loads and its path builds", "[scenario][files]") 
   CHECK(n >= 8);
 }
 
+TEST_CASE("`long_run` lasts 30 minutes of laps", "[scenario][files]") {
+  // The long run of issue 22 (bench/long_run.sh): the path must cover the scenario's 30 minutes, so the
+  // scene is cut by `duration`, not by the end of the waypoints.
+  const auto spec = load_scenario((kScenarios / "long_run.yaml").string());
+  CHECK(spec.duration == 1800.0);
+  CHECK(build_body_trajectory(spec)->duration() >= spec.duration);
+}
+
 TEST_CASE("The VIODE-like family shares one world and path and differs in traffic only", "[scenario][files]") {
   const auto none = load_scenario((kScenarios / "none.yaml").string());
   for (const char* level : {"low", "mid", "high", "night"}) {

@@ -1,0 +1,60 @@
+#!/usr/bin/env bash
+# Long run (issue 22; issue 21's scene "for scale"): the `long_run` scene (30 minutes of laps with a
+# revisit every lap, a parked truck moved every 4 minutes, cars passing and crossing) replayed at rate 0
+# with everything on: stereo, the dynavins BA, loop closure (dynavins) and every LCM output, recorded to a
+# file through LCM's file:// provider. While it runs, the process's resident memory is sampled every 2 s
+# from /proc; afterwards `dynavins decode` turns the recorded stats reports (one a second) into per-stage
+# latency over time, and bench/report/long_run_report.py plots memory and latency over time, fits the
+# memory growth per keyframe and writes the report.
+# Writes bench/results/long_run/: REPORT.md, long_run.png, summary.json, rss.csv, stats.csv.gz.
+# Usage: bench/long_run.sh [--duration S]   (S < 1800: a shorter cut of the same scene, as a quick check;
+# its results go to bench/results/long_run-Ss/)
+# Cost: rendering the scene takes about 35 min of this 2-core machine (cached in bench/cache/long_run),
+# the run itself about 30-40 min.
+set -euo pipefail
+cd "$(dirname "$0")/.."
+bin=$(readlink -f "${DYNAVINS:-build/bin/dynavins}")
+duration=
+if [ "${1:-}" = --duration ]; then duration=$2; shift 2; fi
+[ $# -eq 0 ] || { echo "usage: bench/long_run.sh [--duration S]" >&2; exit 2; }
+
+name=long_run sim_args=()
+if [ -n "$duration" ]; then name=long_run-${duration}s sim_args=(--duration "$duration"); fi
+DYNAVINS=$bin CACHE_AS=$name scripts/cached-sim.sh long_run "${sim_args[@]}"
+scene=bench/cache/$name
+out=bench/results/$name
+tmp=$(mktemp -d)
+trap 'rm -rf "$tmp"' EXIT
+
+# The scene's calibration: the simulator writes its VINS-Fusion config with --euroc; half a second of the
+# same scenario gives it without a second copy of 30 minutes of images.
+"$bin" sim --scenario long_run --duration 0.5 --euroc --out "$tmp/calib" > "$tmp/calib.log" 2>&1 ||
+  { cat "$tmp/calib.log"; exit 1; }
+
+"$bin" run --config "$tmp/calib/euroc/vins_config.yaml" --log "$scene/sensors.lcmlog" --rate 0 --ba dynavins \
+  --loop dynavins --lcm-url "file://$tmp/outputs.lcmlog?mode=w" --out "$tmp/run" > "$tmp/run.log" 2>&1 &
+pid=$!
+start=$(date +%s.%N)
+echo "wall_s,rss_kb" > "$tmp/rss.csv"
+while kill -0 $pid 2>/dev/null; do
+  rss=$(awk '/^VmRSS:/ {print $2}' /proc/$pid/status 2>/dev/null || true)
+  [ -n "$rss" ] && awk -v s="$start" -v n="$(date +%s.%N)" -v r="$rss" 'BEGIN {printf "%.1f,%s\n", n - s, r}' >> "$tmp/rss.csv"
+  sleep 2
+done
+rc=0; wait $pid || rc=$?
+tail -12 "$tmp/run.log"
+[ $rc -eq 0 ] || { echo "long_run: dynavins run exited $rc" >&2; exit 1; }
+
+"$bin" decode --log "$tmp/outputs.lcmlog" --out "$tmp/decoded" > "$tmp/decode.txt" ||
+  { cat "$tmp/decode.txt"; echo "long_run: decode found problems in the LCM outputs" >&2; exit 1; }
+"$bin" eval --gt "$scene/groundtruth.tum" --est "$tmp/run/trajectory.tum" --json "$tmp/ate_trajectory.json" > /dev/null
+"$bin" eval --gt "$scene/groundtruth.tum" --est "$tmp/run/odometry.tum" --json "$tmp/ate_odometry.json" > /dev/null
+
+mkdir -p "$out"
+cp "$tmp/run/summary.json" "$tmp/rss.csv" "$tmp/decode.txt" "$out/"
+gzip -9 -c "$tmp/decoded/stats.csv" > "$out/stats.csv.gz"
+gzip -9 -c "$tmp/decoded/queues.csv" > "$out/queues.csv.gz"
+gzip -9 -c "$tmp/run/loops.csv" > "$out/loops.csv.gz"
+/usr/bin/python3 bench/report/long_run_report.py --dir "$out" --ate-odometry "$tmp/ate_odometry.json" \
+  --ate-trajectory "$tmp/ate_trajectory.json" --command "bench/long_run.sh ${duration:+--duration $duration}"
+echo "long_run: wrote $out/REPORT.md and $out/long_run.png"
