@@ -163,7 +163,8 @@ def main():
         f"{lp.get('false_loops_used', 0)} false used, {lp.get('true_loops_used', 0)} true used; "
         f"{lp.get('optimizations', 0)} optimisations, {lp.get('optimization_ms_mean', 0):.0f} ms mean, "
         f"{lp.get('optimization_ms_max', 0):.0f} ms max; {lp.get('keyframe_ms_mean', 0):.1f} ms per keyframe "
-        f"(p95 {lp.get('keyframe_ms_p95', 0):.1f}, max {lp.get('keyframe_ms_max', 0):.0f}).",
+        f"(p95 {lp.get('keyframe_ms_p95', 0):.1f}, max {lp.get('keyframe_ms_max', 0):.0f}; the loop thread's CPU "
+        f"{lp.get('keyframe_cpu_ms_mean', float('nan')):.1f} ms per keyframe).",
         "",
         "Raw: summary.json, rss.csv, stats.csv.gz and queues.csv.gz (decoded stats reports), loops.csv.gz, "
         "decode.txt (the LCM recording's check).",

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <chrono>
+#include <ctime>
 #include <stdexcept>
 #include <utility>
 
@@ -12,6 +13,15 @@
 #include "stages/loop/place/vocabulary_tree.hpp"
 
 namespace dynavins::pipeline {
+
+namespace {
+/// CPU time of the calling thread [ms].
+double thread_cpu_ms() {
+  timespec ts{};
+  clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts);
+  return 1e3 * static_cast<double>(ts.tv_sec) + 1e-6 * static_cast<double>(ts.tv_nsec);
+}
+}  // namespace
 
 LoopStage::LoopStage(loop::LoopMode mode, const std::string& vocabulary_path, std::shared_ptr<const CameraModel> camera)
     : mode_(mode), vocabulary_path_(vocabulary_path) {
@@ -50,7 +60,9 @@ void LoopStage::account(const loop::LoopCloserOutput& out, double ms) {
 
 void LoopStage::process(Keyframe keyframe) {
   const auto t0 = std::chrono::steady_clock::now();
+  const double cpu0 = thread_cpu_ms();
   const loop::LoopCloserOutput out = closer_->add_keyframe(keyframe);
+  cpu_ms_sum_ += thread_cpu_ms() - cpu0;
   ++keyframes_;
   const double ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
   keyframe_ms_.push_back(ms);
@@ -75,6 +87,7 @@ LoopRunSummary LoopStage::summary() const {
   s.groups = static_cast<int64_t>(closer_->groups().size());
   s.optimizations = closer_->num_optimizations();
   s.keyframe_ms_mean = keyframes_ > 0 ? ms_sum_ / static_cast<double>(keyframes_) : 0.0;
+  s.keyframe_cpu_ms_mean = keyframes_ > 0 ? cpu_ms_sum_ / static_cast<double>(keyframes_) : 0.0;
   s.keyframe_ms_max = ms_max_;
   if (!keyframe_ms_.empty()) {
     std::vector<double> sorted = keyframe_ms_;
