@@ -1,28 +1,39 @@
 #!/usr/bin/env bash
 # Long run (issue 22; issue 21's scene "for scale"): the `long_run` scene (30 minutes of laps with a
 # revisit every lap, a parked truck moved every 4 minutes, cars passing and crossing) replayed at rate 0
-# with everything on: stereo, the dynavins BA, loop closure (dynavins) and every LCM output, recorded to a
+# with everything on: stereo, the dynavins BA, loop closure (--loop, default dynavins) and every LCM output, recorded to a
 # file through LCM's file:// provider. While it runs, the process's resident memory is sampled every 2 s
 # from /proc; afterwards `dynavins decode` turns the recorded stats reports (one a second) into per-stage
 # latency over time, and bench/report/long_run_report.py plots memory and latency over time, fits the
 # memory growth per keyframe and writes the report.
-# Writes bench/results/long_run/: REPORT.md, long_run.png, summary.json, rss.csv, stats.csv.gz.
-# Usage: bench/long_run.sh [--duration S]   (S < 1800: a shorter cut of the same scene, as a quick check;
-# its results go to bench/results/long_run-Ss/)
-# Cost: rendering the scene takes about 35 min of this 2-core machine (cached in bench/cache/long_run),
-# the run itself about 30-40 min.
+# Writes bench/results/long_run[-loopMODE][-Ss]/: REPORT.md, long_run.png, summary.json, rss.csv,
+# stats.csv.gz, queues.csv.gz, loops.csv.gz, decode.txt.
+# Usage: bench/long_run.sh [--duration S] [--loop MODE] [--max-wall-min M]
+#   --duration S      a shorter cut of the same scene (rendered and cached apart), as a quick check
+#   --loop MODE       loop closure mode (default dynavins; off: the odometry pipeline alone)
+#   --max-wall-min M  stop the run with SIGINT after M minutes of wall time: the report then covers the
+#                     data processed until then and says so (summary.json: interrupted: true)
+# Cost: rendering the scene takes about 45 min of this 2-core machine (cached in bench/cache/long_run);
+# the run with --loop off about 20 min.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 bin=$(readlink -f "${DYNAVINS:-build/bin/dynavins}")
-duration=
-if [ "${1:-}" = --duration ]; then duration=$2; shift 2; fi
-[ $# -eq 0 ] || { echo "usage: bench/long_run.sh [--duration S]" >&2; exit 2; }
+duration= loop=dynavins max_wall_min=
+while [ $# -gt 0 ]; do
+  case $1 in
+    --duration) duration=$2; shift 2 ;;
+    --loop) loop=$2; shift 2 ;;
+    --max-wall-min) max_wall_min=$2; shift 2 ;;
+    *) echo "usage: bench/long_run.sh [--duration S] [--loop MODE] [--max-wall-min M]" >&2; exit 2 ;;
+  esac
+done
 
 name=long_run sim_args=()
 if [ -n "$duration" ]; then name=long_run-${duration}s sim_args=(--duration "$duration"); fi
 DYNAVINS=$bin CACHE_AS=$name scripts/cached-sim.sh long_run "${sim_args[@]}"
 scene=bench/cache/$name
-out=bench/results/$name
+out=bench/results/long_run${loop:+-loop$loop}${duration:+-${duration}s}
+[ "$loop" = dynavins ] && out=bench/results/long_run${duration:+-${duration}s}
 tmp=$(mktemp -d)
 trap 'rm -rf "$tmp"' EXIT
 
@@ -32,29 +43,38 @@ trap 'rm -rf "$tmp"' EXIT
   { cat "$tmp/calib.log"; exit 1; }
 
 "$bin" run --config "$tmp/calib/euroc/vins_config.yaml" --log "$scene/sensors.lcmlog" --rate 0 --ba dynavins \
-  --loop dynavins --lcm-url "file://$tmp/outputs.lcmlog?mode=w" --out "$tmp/run" > "$tmp/run.log" 2>&1 &
+  --loop "$loop" --lcm-url "file://$tmp/outputs.lcmlog?mode=w" --out "$tmp/run" > "$tmp/run.log" 2>&1 &
 pid=$!
 start=$(date +%s.%N)
 echo "wall_s,rss_kb" > "$tmp/rss.csv"
 while kill -0 $pid 2>/dev/null; do
   rss=$(awk '/^VmRSS:/ {print $2}' /proc/$pid/status 2>/dev/null || true)
+  if [ -n "$max_wall_min" ] && [ ! -e "$tmp/stopped" ] &&
+     awk -v s="$start" -v n="$(date +%s.%N)" -v m="$max_wall_min" 'BEGIN {exit !(n - s > 60 * m)}'; then
+    kill -INT $pid; touch "$tmp/stopped"
+  fi
   [ -n "$rss" ] && awk -v s="$start" -v n="$(date +%s.%N)" -v r="$rss" 'BEGIN {printf "%.1f,%s\n", n - s, r}' >> "$tmp/rss.csv"
   sleep 2
 done
 rc=0; wait $pid || rc=$?
 tail -12 "$tmp/run.log"
-[ $rc -eq 0 ] || { echo "long_run: dynavins run exited $rc" >&2; exit 1; }
+if [ $rc -ne 0 ] && ! { [ -e "$tmp/stopped" ] && grep -q '"interrupted": true' "$tmp/run/summary.json"; }; then
+  echo "long_run: dynavins run exited $rc" >&2; exit 1
+fi
 
 "$bin" decode --log "$tmp/outputs.lcmlog" --out "$tmp/decoded" > "$tmp/decode.txt" ||
   { cat "$tmp/decode.txt"; echo "long_run: decode found problems in the LCM outputs" >&2; exit 1; }
-"$bin" eval --gt "$scene/groundtruth.tum" --est "$tmp/run/trajectory.tum" --json "$tmp/ate_trajectory.json" > /dev/null
-"$bin" eval --gt "$scene/groundtruth.tum" --est "$tmp/run/odometry.tum" --json "$tmp/ate_odometry.json" > /dev/null
+for est in odometry trajectory; do  # an ATE that cannot be computed (e.g. a straight-line cut) is reported as such
+  "$bin" eval --gt "$scene/groundtruth.tum" --est "$tmp/run/$est.tum" --json "$tmp/ate_$est.json" > /dev/null 2>&1 ||
+    echo '{"ate": {"rmse": null}}' > "$tmp/ate_$est.json"
+done
 
 mkdir -p "$out"
 cp "$tmp/run/summary.json" "$tmp/rss.csv" "$tmp/decode.txt" "$out/"
 gzip -9 -c "$tmp/decoded/stats.csv" > "$out/stats.csv.gz"
 gzip -9 -c "$tmp/decoded/queues.csv" > "$out/queues.csv.gz"
-gzip -9 -c "$tmp/run/loops.csv" > "$out/loops.csv.gz"
+[ ! -f "$tmp/run/loops.csv" ] || gzip -9 -c "$tmp/run/loops.csv" > "$out/loops.csv.gz"
 /usr/bin/python3 bench/report/long_run_report.py --dir "$out" --ate-odometry "$tmp/ate_odometry.json" \
-  --ate-trajectory "$tmp/ate_trajectory.json" --command "bench/long_run.sh ${duration:+--duration $duration}"
+  --ate-trajectory "$tmp/ate_trajectory.json" --loop "$loop" \
+  --command "bench/long_run.sh${duration:+ --duration $duration} --loop $loop${max_wall_min:+ --max-wall-min $max_wall_min}"
 echo "long_run: wrote $out/REPORT.md and $out/long_run.png"

@@ -58,12 +58,17 @@ def interval_means(t, n, m, bin_s=BIN_S):
     return np.array(centres), np.array(means), np.array(counts)
 
 
+def metres(x):
+    return "not computed" if x is None else f"{x:.3f} m"
+
+
 def main():
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--dir", required=True)
     ap.add_argument("--ate-odometry", required=True, help="dynavins eval --json of odometry.tum")
     ap.add_argument("--ate-trajectory", required=True, help="dynavins eval --json of trajectory.tum")
     ap.add_argument("--command", default="bench/long_run.sh")
+    ap.add_argument("--loop", default="dynavins", help="the run's --loop mode")
     a = ap.parse_args()
 
     s = json.load(open(os.path.join(a.dir, "summary.json")))
@@ -77,6 +82,7 @@ def main():
     t_kf, n_kf, _ = stage_series(stats, "loop")
     kf_at_rss = np.interp(t_rss, t_kf, n_kf) if len(t_kf) else np.zeros_like(t_rss)
     half = t_rss >= 0.5 * t_rss[-1]
+    slope_mb_per_min = np.polyfit(t_rss[half] / 60.0, mb[half], 1)[0] if half.sum() > 2 else float("nan")
     slope_kb = float("nan")
     if half.sum() > 2 and np.ptp(kf_at_rss[half]) > 0:
         slope_kb = np.polyfit(kf_at_rss[half], mb[half] * 1024.0, 1)[0]
@@ -95,8 +101,9 @@ def main():
     ax0b = ax[0].twinx()
     ax0b.plot(t_kf / 60.0, n_kf, color="tab:gray", lw=1.0, ls="--")
     ax0b.set_ylabel("keyframes in the loop closer's database", color="tab:gray")
-    ax[0].set_title(f"long_run: {s['data_s'] / 60:.1f} min of data at rate 0, stereo, dynavins BA, loop closure "
-                    f"dynavins, LCM outputs on (growth {slope_kb:.1f} kB per keyframe)", fontsize=9)
+    stopped = " (stopped: interrupted)" if s.get("interrupted") else ""
+    ax[0].set_title(f"long_run: {s['data_s'] / 60:.1f} min of data at rate 0{stopped}, stereo, dynavins BA, loop "
+                    f"closure {a.loop}, LCM outputs on; second half: {slope_mb_per_min:+.2f} MB/min", fontsize=9)
     for stage, colour in zip(STAGES, ["tab:green", "tab:orange", "tab:red"]):
         t, n, m = stage_series(stats, stage)
         if len(t) == 0:
@@ -119,7 +126,7 @@ def main():
 
     def at_fraction(f):
         i = min(len(mb) - 1, int(f * (len(mb) - 1)))
-        return f"{mb[i]:.0f} MB ({kf_at_rss[i]:.0f} kf)"
+        return f"{mb[i]:.0f} MB ({kf_at_rss[i]:.0f} kf)" if keyframes else f"{mb[i]:.0f} MB"
 
     def stage_row(stage):
         t, n, m = stage_series(stats, stage)
@@ -132,10 +139,13 @@ def main():
                 f"{st.get('p95', 0):.1f} |")
 
     lines = [
-        f"# Long run: memory and latency over {s['data_s'] / 60:.0f} minutes",
+        f"# Long run (`--loop {a.loop}`): memory and latency over {s['data_s'] / 60:.1f} minutes of data",
         "",
+    ] + ([f"**Stopped (SIGINT) after {s['wall_s'] / 60:.0f} min of wall time, at {s['data_s']:.0f} s of data "
+          f"(of the scene's whole length): these figures cover that part only** (summary.json: interrupted: true).", ""]
+         if s.get("interrupted") else []) + [
         f"`{a.command.strip()}`, {datetime.now(timezone.utc):%Y-%m-%d}: the `long_run` scene "
-        f"(bench/scenarios/long_run.yaml) at rate 0 (lossless), stereo, `--ba dynavins --loop dynavins`, every "
+        f"(bench/scenarios/long_run.yaml) at rate 0 (lossless), stereo, `--ba dynavins --loop {a.loop}`, every "
         f"LCM output recorded (file:// provider). Memory: VmRSS sampled every 2 s. Latency: per-stage time per "
         f"item from the stats reports (one a second), mean per {BIN_S:.0f} s of wall time.",
         "",
@@ -144,12 +154,14 @@ def main():
         "| data | wall | real-time factor | frames in / estimated / dropped | resets | ATE odometry | ATE loop-corrected |",
         "|---|---|---|---|---|---|---|",
         f"| {s['data_s']:.0f} s | {s['wall_s']:.0f} s | {s['real_time_factor']:.2f} | {s['frames_in']} / "
-        f"{s['frames_estimated']} / {s['frames_dropped']} | {s['resets']} | {ate_odo:.3f} m | {ate_traj:.3f} m |",
+        f"{s['frames_estimated']} / {s['frames_dropped']} | {s['resets']} | {metres(ate_odo)} | {metres(ate_traj)} |",
         "",
         "**Memory.** " + f"peak {s['peak_rss_mb']:.0f} MB; at 10 % of the run {at_fraction(0.1)}, at 50 % "
-        f"{at_fraction(0.5)}, at the end {at_fraction(1.0)}. Growth over the second half: "
-        f"**{slope_kb:.1f} kB per keyframe** (least squares, RSS against keyframes); the keyframe database "
-        f"reports {db_kb_per_kf:.1f} kB per keyframe ({lp.get('memory_kb', 0) / 1024:.0f} MB for {keyframes}).",
+        f"{at_fraction(0.5)}, at the end {at_fraction(1.0)}. Growth over the second half (least squares): "
+        f"**{slope_mb_per_min:+.2f} MB per minute**" + (
+            f", **{slope_kb:.1f} kB per keyframe** (RSS against the loop closer's keyframes); the keyframe "
+            f"database reports {db_kb_per_kf:.1f} kB per keyframe ({lp.get('memory_kb', 0) / 1024:.0f} MB for "
+            f"{keyframes})." if keyframes else " (no loop closer: nothing is meant to grow)."),
         "",
         "**Latency per stage** (ms per item; first and last sixth of the run, and the whole run's mean / p95 from "
         "summary.json):",
@@ -158,7 +170,7 @@ def main():
         "|---|---|---|---|---|",
     ] + [stage_row(x) for x in STAGES] + [
         "",
-        f"**Loop closure.** {keyframes} keyframes ({lp.get('keyframes_dropped', 0)} dropped), {lp.get('loops', 0)} "
+        "**Loop closure.** off." if a.loop == "off" else f"**Loop closure.** {keyframes} keyframes ({lp.get('keyframes_dropped', 0)} dropped), {lp.get('loops', 0)} "
         f"verified loops ({lp.get('true_loops', 0)} true, {lp.get('false_loops', 0)} false against the ground truth), "
         f"{lp.get('false_loops_used', 0)} false used, {lp.get('true_loops_used', 0)} true used; "
         f"{lp.get('optimizations', 0)} optimisations, {lp.get('optimization_ms_mean', 0):.0f} ms mean, "
