@@ -142,7 +142,7 @@ def main():
         f"# Long run (`--loop {a.loop}`): memory and latency over {s['data_s'] / 60:.1f} minutes of data",
         "",
     ] + ([f"**Stopped (SIGINT) after {s['wall_s'] / 60:.0f} min of wall time, at {s['data_s']:.0f} s of data "
-          f"(of the scene's whole length): these figures cover that part only** (summary.json: interrupted: true).", ""]
+          f"(not the whole scene): these figures cover that part only** (summary.json: interrupted: true).", ""]
          if s.get("interrupted") else []) + [
         f"`{a.command.strip()}`, {datetime.now(timezone.utc):%Y-%m-%d}: the `long_run` scene "
         f"(bench/scenarios/long_run.yaml) at rate 0 (lossless), stereo, `--ba dynavins --loop {a.loop}`, every "
