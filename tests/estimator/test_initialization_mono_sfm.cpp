@@ -120,6 +120,23 @@ TEST_CASE("mono SfM fails on a pure rotation", "[estimator][initialization]") {
   CHECK(r.reason.find("pure rotation") != std::string::npos);
 }
 
+namespace {
+/// Adds `count` features that keep their pixels in every frame (riders, or points at infinity on a
+/// straight drive) at random positions, with `noise_px` of pixel noise; returns the first one's id.
+FeatureId add_still_features(Scenario& s, int count, unsigned seed, double noise_px) {
+  std::mt19937 rng(seed);
+  std::uniform_real_distribution<double> u(-0.6, 0.6);
+  std::normal_distribution<double> noise(0.0, (noise_px > 0.0 ? noise_px : 1.0) / Scenario::kFocal);  // stddev > 0
+  const FeatureId first = FeatureId(1) << 40;
+  for (int j = 0; j < count; ++j) {
+    const Eigen::Vector2d x(u(rng), u(rng));
+    for (FrameFeatures& f : s.features)
+      f[first + j] = noise_px > 0.0 ? Eigen::Vector2d(x + Eigen::Vector2d(noise(rng), noise(rng))) : x;
+  }
+  return first;
+}
+}  // namespace
+
 TEST_CASE("mono SfM initialises while most of the view moves with the camera", "[estimator][initialization]") {
   // Issue 23: a truck leading the camera a few metres ahead stays at the same pixels while the camera
   // drives. Here twice as many such features as static ones (fixed image positions in every frame, the
@@ -130,15 +147,7 @@ TEST_CASE("mono SfM initialises while most of the view moves with the camera", "
   ScenarioOptions o;
   o.pixel_noise_px = 0.5;
   Scenario s = make_scenario(o);
-  std::mt19937 rng(5);
-  std::uniform_real_distribution<double> u(-0.6, 0.6);
-  std::normal_distribution<double> noise(0.0, o.pixel_noise_px / Scenario::kFocal);
-  const FeatureId rider0 = FeatureId(1) << 40;
-  const int riders = 2 * static_cast<int>(s.features.back().size());
-  for (int j = 0; j < riders; ++j) {
-    const Eigen::Vector2d x(u(rng), u(rng));
-    for (FrameFeatures& f : s.features) f[rider0 + j] = x + Eigen::Vector2d(noise(rng), noise(rng));
-  }
+  const FeatureId rider0 = add_still_features(s, 2 * static_cast<int>(s.features.back().size()), 5, o.pixel_noise_px);
 
   MonoSfmOptions vins_mean;  // VINS-Fusion's test: the mean over all common features
   vins_mean.min_feature_motion_px = 0.0;
@@ -166,15 +175,8 @@ TEST_CASE("mono SfM is VINS-Fusion's while few features are still", "[estimator]
   ScenarioOptions o;
   o.pixel_noise_px = 0.5;
   Scenario s = make_scenario(o);
-  std::mt19937 rng(6);
-  std::uniform_real_distribution<double> u(-0.6, 0.6);
-  const FeatureId still0 = FeatureId(1) << 40;
-  const int still = static_cast<int>(s.features.back().size()) / 9;
-  REQUIRE(still >= 3);
-  for (int j = 0; j < still; ++j) {
-    const Eigen::Vector2d x(u(rng), u(rng));
-    for (FrameFeatures& f : s.features) f[still0 + j] = x;
-  }
+  REQUIRE(s.features.back().size() >= 27);
+  add_still_features(s, static_cast<int>(s.features.back().size()) / 9, 6, 0.0);
   MonoSfmOptions vins;  // never suspects riders
   vins.max_still_share = 1.0;
   const MonoSfmResult a = solve_mono_sfm(s.features), b = solve_mono_sfm(s.features, vins);
