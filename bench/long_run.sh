@@ -1,8 +1,8 @@
 #!/usr/bin/env bash
 # Long run (issue 22; issue 21's scene "for scale"): the `long_run` scene (30 minutes of laps with a
 # revisit every lap, a parked truck moved every 4 minutes, cars passing and crossing) replayed at rate 0
-# with everything on: stereo, the dynavins BA, loop closure (--loop, default dynavins) and every LCM output, recorded to a
-# file through LCM's file:// provider. While it runs, the process's resident memory is sampled every 2 s
+# with everything on: stereo, the dynavins BA, loop closure (--loop, default dynavins) and every LCM
+# output, recorded to a file through LCM's file:// provider. While it runs, the process's resident memory is sampled every 2 s
 # from /proc; afterwards `dynavins decode` turns the recorded stats reports (one a second) into per-stage
 # latency over time, and bench/report/long_run_report.py plots memory and latency over time, fits the
 # memory growth per keyframe and writes the report.
@@ -13,8 +13,8 @@
 #   --loop MODE       loop closure mode (default dynavins; off: the odometry pipeline alone)
 #   --max-wall-min M  stop the run with SIGINT after M minutes of wall time: the report then covers the
 #                     data processed until then and says so (summary.json: interrupted: true)
-# Cost: rendering the scene takes about 45 min of this 2-core machine (cached in bench/cache/long_run);
-# the run with --loop off about 20 min.
+# Cost: rendering the scene takes 35-50 min of this 2-core machine (cached in bench/cache/long_run, 15.5 GB);
+# the run with --loop off about 10 min; with loop closure it falls behind (README "Long run").
 set -euo pipefail
 cd "$(dirname "$0")/.."
 bin=$(readlink -f "${DYNAVINS:-build/bin/dynavins}")

@@ -4,7 +4,8 @@
 // [0, 1]) and prints per channel how many arrived and at what rate. With --out it writes the poses as TUM
 // files (pose.tum: window poses, pose_imu.tum: IMU-rate poses) that `dynavins eval` and evo read, the
 // status changes as status.csv, and the pipeline's health reports over time as stats.csv (one row per
-// stage per report) and queues.csv (one row per queue per report), for plots of latency over a long run. Exit 1 when a check fails, 2 when the log cannot be read.
+// stage per report) and queues.csv (one row per queue per report), for plots of latency over a long run.
+// Exit 1 when a check fails, 2 when the log cannot be read.
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
@@ -184,7 +185,8 @@ void run_decode(const DecodeOptions& o) {
               "wait_ms_p95",
               stage_rows);
     write_csv(o.out + "/queues.csv", "wall_s,queue,capacity,depth,max_depth,pushed,delivered,dropped", queue_rows);
-    std::printf("outputs                 %s/pose.tum, pose_imu.tum, status.csv, stats.csv, queues.csv\n", o.out.c_str());
+    std::printf("outputs                 %s/pose.tum, pose_imu.tum, status.csv, stats.csv, queues.csv\n",
+                o.out.c_str());
   }
   if (!f.problems.empty()) {
     for (const auto& p : f.problems) std::fprintf(stderr, "decode: %s\n", p.c_str());

@@ -116,11 +116,13 @@ void print_summary(const pipeline::VioRunResult& r, const pipeline::RunOutputs& 
                 static_cast<long long>(r.publish_dropped), static_cast<long long>(r.publisher->failed),
                 r.publisher->imu_pose_latency.mean_ms, r.publisher->imu_pose_latency_p99_ms);
   if (r.loop)
-    std::printf("loop        %s: %lld keyframes, %zu verified loops, %lld optimisations, %.1f ms per keyframe "
-                "(max %.1f; the loop thread's CPU %.1f)%s\n",
-                loop::loop_mode_name(r.loop->mode), static_cast<long long>(r.loop->keyframes), r.loop->loops.size(),
-                static_cast<long long>(r.loop->optimizations), r.loop->keyframe_ms_mean, r.loop->keyframe_ms_max,
-                r.loop->keyframe_cpu_ms_mean, r.loop->keyframes_dropped ? fmt::format(", {} keyframes dropped", r.loop->keyframes_dropped).c_str() : "");
+    std::printf(
+        "loop        %s: %lld keyframes, %zu verified loops, %lld optimisations, %.1f ms per keyframe "
+        "(max %.1f; the loop thread's CPU %.1f)%s\n",
+        loop::loop_mode_name(r.loop->mode), static_cast<long long>(r.loop->keyframes), r.loop->loops.size(),
+        static_cast<long long>(r.loop->optimizations), r.loop->keyframe_ms_mean, r.loop->keyframe_ms_max,
+        r.loop->keyframe_cpu_ms_mean,
+        r.loop->keyframes_dropped ? fmt::format(", {} keyframes dropped", r.loop->keyframes_dropped).c_str() : "");
   if (outputs.ate().evaluated)
     std::printf("ATE         %.4f m (SE3), %.4f m (Sim3) over %zu poses (odometry)\n", outputs.ate().se3_m,
                 outputs.ate().sim3_m, outputs.ate().matched);

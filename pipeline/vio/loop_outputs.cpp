@@ -75,8 +75,8 @@ std::string loop_json(const LoopRunSummary& l, const LoopTruthCounts& t, bool ha
     << ", \"loops\": " << l.loops.size() << ", \"groups\": " << l.groups << ", \"optimizations\": " << l.optimizations
     << ", \"keyframe_ms_mean\": " << l.keyframe_ms_mean << ", \"keyframe_ms_p95\": " << l.keyframe_ms_p95
     << ", \"keyframe_ms_max\": " << l.keyframe_ms_max << ", \"keyframe_cpu_ms_mean\": " << l.keyframe_cpu_ms_mean
-    << ", \"descriptors_ms_mean\": " << l.descriptors_ms_mean
-    << ", \"query_ms_mean\": " << l.query_ms_mean << ", \"verification_ms_mean\": " << l.verification_ms_mean
+    << ", \"descriptors_ms_mean\": " << l.descriptors_ms_mean << ", \"query_ms_mean\": " << l.query_ms_mean
+    << ", \"verification_ms_mean\": " << l.verification_ms_mean
     << ", \"optimization_ms_mean\": " << l.optimization_ms_mean
     << ", \"optimization_ms_max\": " << l.optimization_ms_max << ", \"memory_kb\": " << l.memory_bytes / 1024.0;
   if (has_truth)
