@@ -3,6 +3,7 @@
 #include "stages/loop/place/loop_verifier.hpp"
 
 #include <cmath>
+#include <utility>
 #include <vector>
 
 #include <opencv2/calib3d.hpp>
@@ -28,6 +29,13 @@ const char* to_string(LoopRejection r) {
   return "?";
 }
 
+namespace {
+/// A keyframe's camera in its (odometry) world frame: T_wc = T_wb * T_bc.
+std::pair<Eigen::Quaterniond, Eigen::Vector3d> camera_in_world(const KeyframeDescriptors& kf) {
+  return {(kf.q_wb * kf.q_bc).normalized(), kf.p_wb + kf.q_wb * kf.p_bc};
+}
+}  // namespace
+
 LoopVerification LoopVerifier::verify(const KeyframeDescriptors& query, const KeyframeDescriptors& match) const {
   LoopVerification v;
   v.loop.query_t_ns = query.t_ns;
@@ -39,9 +47,8 @@ LoopVerification LoopVerifier::verify(const KeyframeDescriptors& query, const Ke
     return v;
   }
 
-  // The candidate's camera C_m in its (odometry) world frame: T_w_cm = T_wb * T_bc.
-  const Eigen::Quaterniond q_wc = (match.q_wb * match.q_bc).normalized();
-  const Eigen::Vector3d p_wc = match.p_wb + match.q_wb * match.p_bc;
+  // The candidate's camera C_m in its (odometry) world frame.
+  const auto [q_wc, p_wc] = camera_in_world(match);
   const Eigen::Matrix3d R_cw = q_wc.conjugate().toRotationMatrix();
   std::vector<cv::Point3d> object;
   std::vector<cv::Point2d> image;
@@ -80,8 +87,7 @@ LoopVerification LoopVerifier::verify(const KeyframeDescriptors& query, const Ke
   cv::cv2eigen(tvec, t_kc_mc);
   if (opts_.two_way_refinement && static_cast<int>(inliers.size()) >= opts_.min_inliers) {
     // The query camera C_k in its own odometry world frame, for its points.
-    const Eigen::Quaterniond q_wck = (query.q_wb * query.q_bc).normalized();
-    const Eigen::Vector3d p_wck = query.p_wb + query.q_wb * query.p_bc;
+    const auto [q_wck, p_wck] = camera_in_world(query);
     std::vector<TwoWayCorrespondence> c;
     c.reserve(inliers.size());
     for (const int i : inliers) {
