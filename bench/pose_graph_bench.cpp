@@ -4,11 +4,19 @@
 // second lap on every keyframe closes one true loop to its twin of the first lap (0.3 m inside), and one
 // group in ten also holds a persistent false hypothesis (5 loops against an object moved 4 m). Groups of
 // 10 keyframes. Prints, per N, the solve time of each mode and the position RMSE before and after.
+// With --incremental N the graph grows as the loop stage grows it: ten keyframes (one group) at a time,
+// an optimisation (dynavins) after each group that brought loops, each warm-started from the previous one
+// (LoopCloserOptions::warm_start; redone from the odometry when it rejects a new group) and, with --cold,
+// beside it the same sequence started from the odometry every time. Prints per 500 keyframes the
+// optimisations, the warm ones redone cold, their mean and max time and the RMSE at the end.
 // Usage: bench_pose_graph [N ...]   (default 250 500 1000 2000 4000)
+//        bench_pose_graph --incremental N [--cold]
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
+#include <cstring>
 #include <vector>
 
 #include "stages/loop/graph/loop_graph_optimizer.hpp"
@@ -88,7 +96,76 @@ double rmse(const SyntheticGraph& g, const std::vector<RigidPose>& poses) {
 
 }  // namespace
 
+/// One optimiser fed group by group, optimising after each group that brought loops.
+struct GrowingGraph {
+  LoopGraphOptimizer optimizer;
+  LoopGraphResult last;
+  bool warm = true;
+  int optimizations = 0, cold_restarts = 0;
+  double ms_sum = 0.0, ms_max = 0.0;
+
+  void optimize() {
+    const auto t0 = std::chrono::steady_clock::now();
+    last = optimizer.optimize(LoopMode::Dynavins, warm && optimizations > 0 ? &last : nullptr);
+    const double ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+    ++optimizations, ms_sum += ms, ms_max = std::max(ms_max, ms);
+    if (last.cold_restart) ++cold_restarts;
+  }
+  void restart_bucket() { optimizations = 0, cold_restarts = 0, ms_sum = 0.0, ms_max = 0.0; }
+};
+
+double rmse_prefix(const SyntheticGraph& g, const std::vector<RigidPose>& poses) {
+  double s = 0.0;
+  for (std::size_t k = 0; k < poses.size(); ++k) s += (poses[k].p - g.truth[k].p).squaredNorm();
+  return poses.empty() ? 0.0 : std::sqrt(s / static_cast<double>(poses.size()));
+}
+
+int run_incremental(int n, bool cold) {
+  const SyntheticGraph g = make_graph(n);
+  std::vector<GrowingGraph> runs(cold ? 2 : 1);
+  if (cold) runs[1].warm = false;
+  std::printf("%10s %13s %13s %13s %12s %10s", "keyframes", "optimisations", "cold_restarts", "warm_mean_ms",
+              "warm_max_ms", "rmse_warm");
+  if (cold) std::printf(" %13s %12s %10s", "cold_mean_ms", "cold_max_ms", "rmse_cold");
+  std::printf("\n");
+  std::size_t next_loop = 0;
+  for (std::size_t grp = 0; grp < g.groups.size(); ++grp) {
+    const int first = static_cast<int>(grp) * 10;
+    bool loops = false;
+    for (GrowingGraph& r : runs) {
+      for (int k = first; k < first + 10; ++k)
+        r.optimizer.add_keyframe(g.t_ns[static_cast<std::size_t>(k)], g.odometry[static_cast<std::size_t>(k)]);
+      r.optimizer.add_group(g.groups[grp]);
+      std::size_t l = next_loop;
+      for (; l < g.loops.size() && g.loops[l].query_t_ns <= g.groups[grp].t_ns.back(); ++l) r.optimizer.add_loop(g.loops[l]);
+      loops = l > next_loop;
+      if (&r == &runs.back()) next_loop = l;
+      if (loops) r.optimize();
+    }
+    const int kf = first + 10;
+    if (kf % 500 != 0 && grp + 1 != g.groups.size()) continue;
+    std::printf("%10d %13d %13d %13.1f %12.1f %10.3f", kf, runs[0].optimizations, runs[0].cold_restarts,
+                runs[0].optimizations ? runs[0].ms_sum / runs[0].optimizations : 0.0, runs[0].ms_max,
+                rmse_prefix(g, runs[0].last.poses));
+    if (cold)
+      std::printf(" %13.1f %12.1f %10.3f", runs[1].optimizations ? runs[1].ms_sum / runs[1].optimizations : 0.0,
+                  runs[1].ms_max, rmse_prefix(g, runs[1].last.poses));
+    std::printf("\n");
+    std::fflush(stdout);
+    for (GrowingGraph& r : runs) r.restart_bucket();
+  }
+  return 0;
+}
+
 int main(int argc, char** argv) {
+  if (argc >= 3 && std::strcmp(argv[1], "--incremental") == 0) {
+    const int n = std::atoi(argv[2]);
+    if (n < 20) {
+      std::fprintf(stderr, "bench_pose_graph: --incremental N needs N >= 20 (got %s)\n", argv[2]);
+      return 2;
+    }
+    return run_incremental(n, argc >= 4 && std::strcmp(argv[3], "--cold") == 0);
+  }
   std::vector<int> sizes;
   for (int i = 1; i < argc; ++i) sizes.push_back(std::atoi(argv[i]));
   if (sizes.empty()) sizes = {250, 500, 1000, 2000, 4000};

@@ -132,7 +132,9 @@ LoopCloserOutput LoopCloser::finish() {
 void LoopCloser::run_optimization(LoopCloserOutput& out) {
   if (options_.mode == LoopMode::Off) return;  // odometry stays the answer
   const auto t0 = Clock::now();
-  last_result_ = optimizer_.optimize(options_.mode);
+  const bool warm = options_.warm_start && num_optimizations_ > 0;
+  last_result_ = optimizer_.optimize(options_.mode, warm ? &last_result_ : nullptr);
+  if (last_result_.cold_restart) ++num_cold_restarts_;
   out.timing.optimization_ms = ms_since(t0);
   out.optimized = true;
   ++num_optimizations_;

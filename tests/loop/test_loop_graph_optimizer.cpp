@@ -9,6 +9,7 @@
 #include <chrono>
 #include <sstream>
 #include <stdexcept>
+#include <utility>
 
 #include "stages/loop/graph/loop_graph_optimizer.hpp"
 #include "stages/loop/graph/loop_report.hpp"
@@ -164,4 +165,119 @@ TEST_CASE("LoopGraphOptimizer: equal-sized hypotheses, loops outside groups, and
   CHECK(text.rfind("mode,query_t_ns,match_t_ns,inliers,group,group_first_t_ns,hypothesis,weight,used\n", 0) == 0);
   CHECK(std::count(text.begin(), text.end(), '\n') == static_cast<long>(rows.size() + 1));
   CHECK(text.find("\ndynavins," + std::to_string(s.loops[0].query_t_ns) + ",") != std::string::npos);
+}
+
+namespace {
+
+/// The loop stage's use of the optimizer: keyframes and groups arrive in time order, and after each group
+/// that brought loops the graph is optimised (dynavins), warm-started from the previous result when
+/// `warm`. Returns the last result, which loops each optimisation adopted, the warm ones redone from the
+/// odometry and the Ceres iterations of all of them.
+struct Incremental {
+  LoopGraphResult last;
+  std::vector<bool> loop_is_true;  ///< per loop in the optimizer's order (groups' order, not the scenario's)
+  std::vector<std::vector<bool>> adopted;  ///< per optimisation, per loop: weight >= 0.5
+  int optimizations = 0, cold_restarts = 0, solver_iterations = 0;
+};
+
+Incremental optimize_as_it_grows(const LoopScenario& s, bool warm) {
+  LoopGraphOptimizer opt;
+  Incremental out;
+  for (std::size_t g = 0; g < s.groups.size(); ++g) {
+    for (std::size_t k = 10 * g; k < 10 * g + 10; ++k) opt.add_keyframe(s.t_ns[k], s.odom[k]);
+    REQUIRE(opt.add_group(s.groups[g]));
+    bool loops = false;
+    for (std::size_t l = 0; l < s.loops.size(); ++l) {
+      if (s.loops[l].query_t_ns < s.groups[g].first_t_ns() || s.loops[l].query_t_ns > s.groups[g].t_ns.back())
+        continue;
+      REQUIRE(opt.add_loop(s.loops[l]));
+      out.loop_is_true.push_back(s.loop_is_true[l]);
+      loops = true;
+    }
+    if (!loops) continue;
+    out.last = opt.optimize(LoopMode::Dynavins, warm && out.optimizations > 0 ? &out.last : nullptr);
+    ++out.optimizations;
+    out.cold_restarts += out.last.cold_restart ? 1 : 0;
+    out.solver_iterations += out.last.solver_iterations;
+    std::vector<bool> adopted;
+    for (const LoopResult& l : out.last.loops) adopted.push_back(l.used && l.weight >= 0.5);
+    out.adopted.push_back(adopted);
+  }
+  return out;
+}
+
+/// Smallest weight of a true loop and largest of a false one in the last result.
+std::pair<double, double> weight_split(const Incremental& inc) {
+  double w_true_min = 1.0, w_false_max = 0.0;
+  for (const LoopResult& l : inc.last.loops) {
+    if (inc.loop_is_true[l.loop_index]) w_true_min = std::min(w_true_min, l.weight);
+    else w_false_max = std::max(w_false_max, l.weight);
+  }
+  return {w_true_min, w_false_max};
+}
+
+}  // namespace
+
+TEST_CASE("LoopGraphOptimizer: warm-started as the graph grows, it ends where a solve from the odometry ends",
+          "[loop][optimizer]") {
+  for (const bool with_false_loops : {false, true}) {
+    const LoopScenario s = with_false_loops ? with_false() : true_only();
+    const Incremental warm = optimize_as_it_grows(s, true), cold = optimize_as_it_grows(s, false);
+    const double rmse_warm = s.rmse(warm.last.poses), rmse_cold = s.rmse(cold.last.poses);
+    const auto [true_min, false_max] = weight_split(warm);
+    WARN((with_false_loops ? "with false loops" : "true loops only")
+         << ": warm RMSE " << rmse_warm << " m, " << warm.solver_iterations << " solver iterations in "
+         << warm.optimizations << " optimisations (" << warm.cold_restarts << " redone cold); from the odometry each time "
+         << rmse_cold << " m, " << cold.solver_iterations << " iterations; true loops min weight " << true_min
+         << ", false loops max weight " << false_max);
+    REQUIRE(warm.optimizations == cold.optimizations);
+    CHECK(warm.adopted == cold.adopted);  // after every optimisation, not only the last
+    CHECK(cold.cold_restarts == 0);
+    CHECK(rmse_warm < rmse_cold + 0.01);
+    CHECK(true_min > 0.9);
+    CHECK(false_max < 0.1);
+    // Less work: each warm optimisation starts next to its answer.
+    CHECK(warm.solver_iterations < cold.solver_iterations);
+  }
+}
+
+TEST_CASE("LoopGraphOptimizer: a warm start that leaves a new group rejected is redone from the odometry",
+          "[loop][optimizer]") {
+  // The first group with loops has 3 true loops and 5 false ones that agree with the drifted odometry
+  // (an object moved by just the drift there), while the true ones ask for the whole correction, so the
+  // first optimisation (nothing else to go by) adopts the false hypothesis. The true groups that follow
+  // contradict it; warm-started from that choice, the next optimisations must not keep it.
+  LoopScenario s;
+  s.add_true_loops_in_group(0);
+  for (int c = 0; c < 5; ++c) {
+    const std::size_t q = LoopScenario::kPerLap + 2 * c, m = q - LoopScenario::kPerLap;
+    VerifiedLoop l = s.loops.front();
+    const RigidPose T_m_k = compose(inverse(s.odom[m]), s.odom[q]);
+    l.query_t_ns = s.t_ns[q], l.match_t_ns = s.t_ns[m], l.p_mq = T_m_k.p, l.q_mq = T_m_k.q;
+    s.loops.push_back(l);
+    s.loop_is_true.push_back(false);
+  }
+  for (int j = 1; j < 8; ++j) s.add_true_loops_in_group(j);
+  const Incremental warm = optimize_as_it_grows(s, true), cold = optimize_as_it_grows(s, false);
+  const auto [true_min, false_max] = weight_split(warm);
+  WARN("false group first: warm RMSE " << s.rmse(warm.last.poses) << " m (" << warm.cold_restarts << " of "
+                                       << warm.optimizations << " optimisations redone cold), from the odometry "
+                                       << s.rmse(cold.last.poses) << " m; true loops min weight " << true_min
+                                       << ", false loops max weight " << false_max);
+  // Without the restart the second optimisation keeps the false hypothesis and rejects the new true group
+  // (it recovers only at the third); with it, every optimisation adopts what one from the odometry adopts.
+  CHECK(warm.cold_restarts >= 1);
+  REQUIRE(warm.optimizations == cold.optimizations);
+  CHECK(warm.adopted == cold.adopted);
+  CHECK(s.rmse(warm.last.poses) < s.rmse(cold.last.poses) + 0.01);
+  CHECK(true_min > 0.9);
+  CHECK(false_max < 0.1);
+}
+
+TEST_CASE("LoopGraphOptimizer: a previous result of another graph is refused", "[loop][optimizer]") {
+  const LoopScenario s = true_only();
+  const LoopGraphResult r = make_optimizer(s).optimize(LoopMode::Dynavins);
+  LoopGraphOptimizer small;
+  small.add_keyframe(s.t_ns[0], s.odom[0]);
+  CHECK_THROWS_AS(small.optimize(LoopMode::Dynavins, &r), std::invalid_argument);
 }

@@ -63,6 +63,27 @@ TEST_CASE("PoseGraph4Dof: exact loops remove the drift, roll and pitch stay", "[
   CHECK((g.pose(0).p - s.odom[0].p).norm() == 0.0);  // gauge
 }
 
+TEST_CASE("PoseGraph4Dof: a warm start from the solution stays there, in fewer iterations", "[loop][posegraph]") {
+  LoopScenario s;
+  for (int j = 0; j < 8; ++j) s.add_true_loops_in_group(j);
+  const std::vector<LoopEdge> edges = edges_of(s);
+  PoseGraph4Dof cold(s.odom);
+  const PoseGraphSolveReport r_cold = cold.solve(edges, LoopEdgeLoss::Plain);
+  PoseGraph4Dof warm(s.odom);
+  for (std::size_t k = 0; k < s.odom.size(); ++k) {
+    // set_estimate takes position and yaw only: the truth's roll and pitch must not leak in.
+    warm.set_estimate(k, RigidPose{cold.pose(k).p, quat_from_ypr(yaw_of(cold.pose(k).q), 0.3, -0.2)});
+    CHECK(std::abs(pitch_of(warm.pose(k).q) - pitch_of(s.odom[k].q)) < 1e-9);
+    CHECK(std::abs(roll_of(warm.pose(k).q) - roll_of(s.odom[k].q)) < 1e-9);
+  }
+  const PoseGraphSolveReport r_warm = warm.solve(edges, LoopEdgeLoss::Plain);
+  WARN("warm start at the solution: " << r_warm.iterations << " iterations (from the odometry " << r_cold.iterations
+                                      << ")");
+  CHECK(r_warm.iterations < r_cold.iterations);
+  CHECK(r_warm.final_cost <= r_cold.final_cost * (1.0 + 1e-6));
+  for (std::size_t k = 0; k < s.odom.size(); ++k) CHECK((warm.pose(k).p - cold.pose(k).p).norm() < 1e-4);
+}
+
 TEST_CASE("PoseGraph4Dof: loop residuals vanish at the truth and grow with the error", "[loop][posegraph]") {
   LoopScenario s(0.0, 1.0, 0.0);  // no drift: the odometry is the truth
   for (int j = 0; j < 8; ++j) s.add_true_loops_in_group(j);

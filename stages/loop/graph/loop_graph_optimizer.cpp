@@ -3,6 +3,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <stdexcept>
 
 #include "stages/loop/graph/hypothesis_weights.hpp"
 
@@ -40,11 +41,49 @@ bool LoopGraphOptimizer::add_loop(const VerifiedLoop& loop) {
 
 namespace {
 RigidPose relative_of(const VerifiedLoop& l) { return RigidPose{l.p_mq, l.q_mq.normalized()}; }
+
+/// True when some group holding loops from index `first_new` on has none of its loops adopted.
+bool rejects_a_new_group(const LoopGraphResult& r, std::size_t first_new, double min_weight) {
+  std::vector<int> new_groups;
+  for (std::size_t l = first_new; l < r.loops.size(); ++l)
+    if (r.loops[l].group >= 0) new_groups.push_back(r.loops[l].group);
+  std::sort(new_groups.begin(), new_groups.end());
+  new_groups.erase(std::unique(new_groups.begin(), new_groups.end()), new_groups.end());
+  for (int g : new_groups) {
+    bool adopted = false;
+    for (const LoopResult& l : r.loops) adopted = adopted || (l.group == g && l.used && l.weight >= min_weight);
+    if (!adopted) return true;
+  }
+  return false;
+}
 }  // namespace
 
-LoopGraphResult LoopGraphOptimizer::optimize(LoopMode mode) const {
+void LoopGraphOptimizer::warm_start(PoseGraph4Dof& graph, const LoopGraphResult& previous) const {
+  const std::size_t n = previous.poses.size();
+  if (n > odometry_.size() || previous.loops.size() > loops_.size())
+    throw std::invalid_argument("LoopGraphOptimizer: the previous result is not of this graph");
+  if (n == 0) return;
+  for (std::size_t k = 0; k < n; ++k) graph.set_estimate(k, previous.poses[k]);
+  // Keyframes added since: odometry moved by the last previous keyframe's correction (the drift then).
+  const RigidPose drift = compose(previous.poses[n - 1], inverse(odometry_[n - 1]));
+  for (std::size_t k = n; k < odometry_.size(); ++k) graph.set_estimate(k, compose(drift, odometry_[k]));
+}
+
+LoopGraphResult LoopGraphOptimizer::optimize(LoopMode mode, const LoopGraphResult* previous) const {
+  LoopGraphResult result = optimize_from(previous, mode);
+  if (previous != nullptr && rejects_a_new_group(result, previous->loops.size(), options_.adopted_min_weight)) {
+    const int warm_iterations = result.solver_iterations;
+    result = optimize_from(nullptr, mode);
+    result.cold_restart = true;
+    result.solver_iterations += warm_iterations;
+  }
+  return result;
+}
+
+LoopGraphResult LoopGraphOptimizer::optimize_from(const LoopGraphResult* previous, LoopMode mode) const {
   PoseGraph4Dof graph(odometry_, options_.graph);
-  if (mode == LoopMode::Dynavins) return optimize_dynavins(graph);
+  if (previous != nullptr) warm_start(graph, *previous);
+  if (mode == LoopMode::Dynavins) return optimize_dynavins(graph, previous);
 
   LoopGraphResult result;
   result.loops.resize(loops_.size());
@@ -55,12 +94,13 @@ LoopGraphResult LoopGraphOptimizer::optimize(LoopMode mode) const {
     edges.push_back(LoopEdge{loop_nodes_[l].match, loop_nodes_[l].query, relative_of(loops_[l]), 1.0});
   }
   if (mode == LoopMode::All && !edges.empty()) {
-    graph.solve(edges, LoopEdgeLoss::Huber);  // VINS-Fusion: every loop, Huber
+    result.solver_iterations = graph.solve(edges, LoopEdgeLoss::Huber).iterations;  // VINS-Fusion: every loop, Huber
     for (LoopResult& r : result.loops) r.weight = 1.0, r.used = true;
     result.alternations = 1;
   } else if (mode == LoopMode::Switchable && !edges.empty()) {
     std::vector<double> s(edges.size(), 1.0);
-    graph.solve(edges, LoopEdgeLoss::Switchable, &s);
+    for (std::size_t l = 0; previous != nullptr && l < previous->loops.size(); ++l) s[l] = previous->loops[l].weight;
+    result.solver_iterations = graph.solve(edges, LoopEdgeLoss::Switchable, &s).iterations;
     for (std::size_t l = 0; l < s.size(); ++l) result.loops[l].weight = s[l], result.loops[l].used = s[l] > 0.0;
     result.alternations = 1;
   }
@@ -95,7 +135,7 @@ HypothesisWeights LoopGraphOptimizer::weight_step(const PoseGraph4Dof& graph, co
                                   static_cast<int>(w.h1.size()), options_.lambda_l);
 }
 
-LoopGraphResult LoopGraphOptimizer::optimize_dynavins(PoseGraph4Dof& graph) const {
+LoopGraphResult LoopGraphOptimizer::optimize_dynavins(PoseGraph4Dof& graph, const LoopGraphResult* previous) const {
   LoopGraphResult result;
   result.loops.resize(loops_.size());
   for (std::size_t l = 0; l < loops_.size(); ++l) {
@@ -110,6 +150,7 @@ LoopGraphResult LoopGraphOptimizer::optimize_dynavins(PoseGraph4Dof& graph) cons
     if (loop_nodes_[l].group >= 0) loops_of_group[static_cast<std::size_t>(loop_nodes_[l].group)].push_back(l);
 
   std::vector<GroupWeights> state;  // per active group
+  bool settled = false;             // the last pose solve's weights are within the tolerance of state's
   for (int round = 0; round < std::max(1, options_.max_rounds); ++round) {
     // IV-B: (re-)cluster every group's loops with the current poses of the match keyframes.
     std::vector<GroupWeights> next;
@@ -137,20 +178,25 @@ LoopGraphResult LoopGraphOptimizer::optimize_dynavins(PoseGraph4Dof& graph) cons
     for (std::size_t a = 0; same && a < next.size(); ++a) same = next[a].h0 == state[a].h0 && next[a].h1 == state[a].h1;
     if (same) break;
     // After the first round the poses are already corrected: a group starts from its previous weights
-    // if its hypotheses are unchanged, else from a weight step at the current poses.
-    for (std::size_t a = 0; round > 0 && a < next.size(); ++a) {
-      const HypothesisWeights nw = weight_step(graph, next[a]);
-      next[a].w0 = nw.w0, next[a].w1 = nw.w1;
-      for (const GroupWeights& old : state)
+    // if its hypotheses are unchanged, else from a weight step at the current poses. Warm-started, the
+    // first round keeps the previous optimisation's weights of unchanged groups (a group new since then
+    // keeps the even split: its keyframes still carry the drift gathered since).
+    for (std::size_t a = 0; a < next.size(); ++a) {
+      if (round > 0) {
+        const HypothesisWeights nw = weight_step(graph, next[a]);
+        next[a].w0 = nw.w0, next[a].w1 = nw.w1;
+      }
+      for (const GroupWeights& old : round > 0 ? state : previous != nullptr ? previous->groups : state)
         if (old.group == next[a].group && old.h0 == next[a].h0 && old.h1 == next[a].h1)
           next[a].w0 = old.w0, next[a].w1 = old.w1;
     }
     state = std::move(next);
     result.rounds = round + 1;
 
+    settled = false;
     for (int it = 0; it < std::max(1, options_.max_alternations); ++it) {
       // Pose step with the weights fixed (the regulariser does not depend on the poses).
-      graph.solve(weighted_edges(state), LoopEdgeLoss::Plain);
+      result.solver_iterations += graph.solve(weighted_edges(state), LoopEdgeLoss::Plain).iterations;
       ++result.alternations;
       // Weight step with the poses fixed: closed form (hypothesis_weights.cpp).
       double max_change = 0.0;
@@ -159,12 +205,16 @@ LoopGraphResult LoopGraphOptimizer::optimize_dynavins(PoseGraph4Dof& graph) cons
         max_change = std::max({max_change, std::abs(nw.w0 - w.w0), std::abs(nw.w1 - w.w1)});
         w.w0 = nw.w0, w.w1 = nw.w1;
       }
-      if (max_change < options_.weight_tolerance) break;
+      settled = max_change < options_.weight_tolerance;
+      if (settled) break;
     }
   }
-  // Final pose solve with the settled weights, so poses and reported weights belong together.
-  graph.solve(weighted_edges(state), LoopEdgeLoss::Plain);
-  ++result.alternations;
+  // Final pose solve with the settled weights, so poses and reported weights belong together; not needed
+  // when the last weight step moved no weight by more than the tolerance (the poses are already those).
+  if (!settled) {
+    result.solver_iterations += graph.solve(weighted_edges(state), LoopEdgeLoss::Plain).iterations;
+    ++result.alternations;
+  }
   for (const GroupWeights& w : state) {
     for (std::size_t l : w.h0)
       result.loops[l].hypothesis = 0, result.loops[l].weight = w.w0, result.loops[l].used = w.w0 > 0.0;

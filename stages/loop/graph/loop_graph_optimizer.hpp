@@ -27,6 +27,8 @@ struct LoopGraphOptions {
   int max_alternations = 10;       ///< weight step + pose solve pairs per round
   double weight_tolerance = 1e-3;  ///< the alternation stops when no weight moves more than this
   int max_rounds = 3;              ///< re-clusterings; stops early when the hypotheses no longer change
+  /// A loop counts as adopted at weight >= this (for the warm start's cold restart, see optimize()).
+  double adopted_min_weight = 0.5;
 };
 
 /// What became of one loop (for loops.csv).
@@ -51,6 +53,8 @@ struct LoopGraphResult {
   std::vector<GroupWeights> groups;  ///< last round's hypotheses and weights (Dynavins), groups with loops
   int rounds = 0;
   int alternations = 0;  ///< total pose solves
+  int solver_iterations = 0;  ///< Ceres iterations of all pose solves (with a cold restart: of both tries)
+  bool cold_restart = false;  ///< warm-started, then redone from the odometry (see optimize())
 };
 
 class LoopGraphOptimizer {
@@ -68,14 +72,27 @@ class LoopGraphOptimizer {
   const std::vector<KeyframeGroup>& groups() const { return groups_; }
   const std::vector<VerifiedLoop>& loops() const { return loops_; }
 
-  /// Runs the pose graph from the odometry (every call starts afresh).
-  LoopGraphResult optimize(LoopMode mode) const;
+  /// Runs the pose graph. Without `previous` it starts from the odometry. With `previous` (an earlier
+  /// optimize() result of this graph, in the same mode) it starts where that one ended: its poses, and
+  /// for keyframes added since, the odometry moved by the newest previous keyframe's correction; its
+  /// switch values (switchable) or the weights of every group whose hypotheses are unchanged (dynavins).
+  /// The incremental use of a growing graph: each solve then only absorbs what is new, in a few
+  /// iterations instead of re-solving the whole drift (VINS-Fusion's pose graph also starts from its last
+  /// estimate). A warm start can keep an earlier wrong choice: a false hypothesis adopted when it was the
+  /// only evidence bends the graph so that later true loops look wrong (measured in bench_pose_graph
+  /// --incremental). So when a group holding loops new since `previous` ends with none of its loops
+  /// adopted (weight >= adopted_min_weight), the optimisation is redone from the odometry and that result
+  /// returned, with cold_restart set. Throws std::invalid_argument if `previous` holds more poses or
+  /// loops than the graph.
+  LoopGraphResult optimize(LoopMode mode, const LoopGraphResult* previous = nullptr) const;
 
  private:
   struct LoopNodes {
     int match = 0, query = 0, group = -1;
   };
-  LoopGraphResult optimize_dynavins(PoseGraph4Dof& graph) const;
+  LoopGraphResult optimize_from(const LoopGraphResult* previous, LoopMode mode) const;
+  LoopGraphResult optimize_dynavins(PoseGraph4Dof& graph, const LoopGraphResult* previous) const;
+  void warm_start(PoseGraph4Dof& graph, const LoopGraphResult& previous) const;
   std::vector<LoopEdge> weighted_edges(const std::vector<GroupWeights>& state) const;
   HypothesisWeights weight_step(const PoseGraph4Dof& graph, const GroupWeights& w) const;
 

@@ -109,6 +109,11 @@ void PoseGraph4Dof::reset_to_odometry() {
   }
 }
 
+void PoseGraph4Dof::set_estimate(std::size_t i, const RigidPose& T_W_i) {
+  for (int a = 0; a < 3; ++a) nodes_[i].p[a] = T_W_i.p[a];
+  nodes_[i].yaw[0] = yaw_of(T_W_i.q);
+}
+
 RigidPose PoseGraph4Dof::pose(std::size_t i) const {
   return RigidPose{Eigen::Vector3d(nodes_[i].p[0], nodes_[i].p[1], nodes_[i].p[2]),
                    quat_from_ypr(nodes_[i].yaw[0], pitch_[i], roll_[i])};

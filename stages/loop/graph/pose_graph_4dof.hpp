@@ -60,6 +60,9 @@ class PoseGraph4Dof {
   RigidPose pose(std::size_t i) const;
   std::vector<RigidPose> poses() const;
   void reset_to_odometry();
+  /// Sets node i's estimate from a full pose: its position and yaw (roll and pitch stay the odometry's).
+  /// Used to warm-start a solve from a previous optimisation's poses.
+  void set_estimate(std::size_t i, const RigidPose& T_W_i);
 
   /// The whitened 4-vector residual of a loop edge at the current estimate, without scale:
   /// [R_m^T (p_k - p_m) - t_mk] / sigma_t, normalize(yaw_k - yaw_m - yaw_mk) / sigma_yaw.
