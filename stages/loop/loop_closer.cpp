@@ -110,8 +110,12 @@ LoopCloserOutput LoopCloser::process(KeyframeDescriptors d, double descriptors_m
   corrected_.push_back(compose(drift_, T_W_k));
   entries_.push_back(std::move(d));
 
-  // IV-C: optimise once the group holding new loops has closed (its hypotheses are then complete).
-  if (out.group_closed && optimizer_.loops().size() > loops_at_last_optimization_) run_optimization(out);
+  // IV-C: optimise once the group holding new loops has closed (its hypotheses are then complete), and
+  // on a large graph not before min_new_keyframe_fraction of it is new (cost per keyframe bounded).
+  const double new_keyframes = static_cast<double>(t_ns_.size() - keyframes_at_last_optimization_);
+  if (out.group_closed && optimizer_.loops().size() > loops_at_last_optimization_ &&
+      new_keyframes >= options_.min_new_keyframe_fraction * static_cast<double>(t_ns_.size()))
+    run_optimization(out);
   out.drift = drift_;
   return out;
 }
@@ -156,6 +160,7 @@ void LoopCloser::run_optimization(LoopCloserOutput& out) {
         w.group, optimizer_.groups()[static_cast<std::size_t>(w.group)].first_t_ns(), w.h0, w.h1, w.w0, w.w1});
   }
   loops_at_last_optimization_ = optimizer_.loops().size();
+  keyframes_at_last_optimization_ = t_ns_.size();
   spdlog::debug("loop closer: {} optimisation over {} keyframes, {} loops, {} groups: {:.1f} ms",
                 loop_mode_name(options_.mode), t_ns_.size(), optimizer_.loops().size(), optimizer_.groups().size(),
                 out.timing.optimization_ms);

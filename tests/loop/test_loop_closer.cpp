@@ -431,6 +431,32 @@ TEST_CASE("LoopCloser: outputs, drift correction, memory per keyframe", "[loop][
   CHECK_THROWS_AS(lc.add_descriptors(w.keyframes.back()), std::invalid_argument);  // not newer
 }
 
+TEST_CASE("LoopCloser: optimisations are spaced in proportion to the graph's size", "[loop][closer]") {
+  // min_new_keyframe_fraction at 0.3 on the 160-keyframe scene stands for 0.01 on a 30-minute run.
+  const World w = make_world();
+  const auto vocab = train_vocabulary(w);
+  std::vector<std::size_t> at[2];  // keyframe counts at each optimisation: fraction 0, 0.3
+  std::vector<RigidPose> poses[2];
+  for (int f = 0; f < 2; ++f) {
+    LoopCloserOptions opts;
+    opts.min_new_keyframe_fraction = f == 0 ? 0.0 : 0.3;
+    LoopCloser lc(vocab, opts);
+    for (const KeyframeDescriptors& kd : w.keyframes)
+      if (lc.add_descriptors(kd).optimized) at[f].push_back(lc.num_keyframes());
+    CHECK(lc.finish().optimized);
+    poses[f] = lc.corrected_poses();
+  }
+  WARN("optimisations before finish(): " << at[0].size() << " at every group closing, " << at[1].size()
+                                         << " spaced by 30 % of the graph");
+  REQUIRE(at[0].size() >= 3);
+  CHECK(at[1].size() < at[0].size());
+  CHECK(!at[1].empty());
+  for (std::size_t i = 1; i < at[1].size(); ++i)
+    CHECK(static_cast<double>(at[1][i] - at[1][i - 1]) >= 0.3 * static_cast<double>(at[1][i]));
+  // finish() optimises the whole graph either way: the same final answer (warm starts from other points).
+  CHECK(w.s.rmse(poses[1]) < w.s.rmse(poses[0]) + 0.02);
+}
+
 TEST_CASE("LoopCloser: a keyframe with an image keeps descriptors, not the image", "[loop][closer]") {
   std::mt19937 rng(3);
   std::uniform_int_distribution<int> gray(0, 255);
