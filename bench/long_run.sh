@@ -14,7 +14,7 @@
 #   --max-wall-min M  stop the run with SIGINT after M minutes of wall time: the report then covers the
 #                     data processed until then and says so (summary.json: interrupted: true)
 # Cost: rendering the scene takes 35-50 min of this 2-core machine (cached in bench/cache/long_run, 15.5 GB);
-# the run with --loop off about 10 min; with loop closure it falls behind (README "Long run").
+# the run with --loop off about 10 min, with loop closure about 15 min (README "Long run").
 set -euo pipefail
 cd "$(dirname "$0")/.."
 bin=$(readlink -f "${DYNAVINS:-build/bin/dynavins}")

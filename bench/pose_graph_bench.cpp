@@ -137,7 +137,8 @@ int run_incremental(int n, bool cold) {
         r.optimizer.add_keyframe(g.t_ns[static_cast<std::size_t>(k)], g.odometry[static_cast<std::size_t>(k)]);
       r.optimizer.add_group(g.groups[grp]);
       std::size_t l = next_loop;
-      for (; l < g.loops.size() && g.loops[l].query_t_ns <= g.groups[grp].t_ns.back(); ++l) r.optimizer.add_loop(g.loops[l]);
+      for (; l < g.loops.size() && g.loops[l].query_t_ns <= g.groups[grp].t_ns.back(); ++l)
+        r.optimizer.add_loop(g.loops[l]);
       loops = l > next_loop;
       if (&r == &runs.back()) next_loop = l;
       if (loops) r.optimize();

@@ -175,7 +175,7 @@ namespace {
 /// odometry and the Ceres iterations of all of them.
 struct Incremental {
   LoopGraphResult last;
-  std::vector<bool> loop_is_true;  ///< per loop in the optimizer's order (groups' order, not the scenario's)
+  std::vector<bool> loop_is_true;          ///< per loop in the optimizer's order (groups' order, not the scenario's)
   std::vector<std::vector<bool>> adopted;  ///< per optimisation, per loop: weight >= 0.5
   int optimizations = 0, cold_restarts = 0, solver_iterations = 0;
 };
@@ -188,8 +188,7 @@ Incremental optimize_as_it_grows(const LoopScenario& s, bool warm) {
     REQUIRE(opt.add_group(s.groups[g]));
     bool loops = false;
     for (std::size_t l = 0; l < s.loops.size(); ++l) {
-      if (s.loops[l].query_t_ns < s.groups[g].first_t_ns() || s.loops[l].query_t_ns > s.groups[g].t_ns.back())
-        continue;
+      if (s.loops[l].query_t_ns < s.groups[g].first_t_ns() || s.loops[l].query_t_ns > s.groups[g].t_ns.back()) continue;
       REQUIRE(opt.add_loop(s.loops[l]));
       out.loop_is_true.push_back(s.loop_is_true[l]);
       loops = true;
@@ -227,9 +226,9 @@ TEST_CASE("LoopGraphOptimizer: warm-started as the graph grows, it ends where a 
     const auto [true_min, false_max] = weight_split(warm);
     WARN((with_false_loops ? "with false loops" : "true loops only")
          << ": warm RMSE " << rmse_warm << " m, " << warm.solver_iterations << " solver iterations in "
-         << warm.optimizations << " optimisations (" << warm.cold_restarts << " redone cold); from the odometry each time "
-         << rmse_cold << " m, " << cold.solver_iterations << " iterations; true loops min weight " << true_min
-         << ", false loops max weight " << false_max);
+         << warm.optimizations << " optimisations (" << warm.cold_restarts
+         << " redone cold); from the odometry each time " << rmse_cold << " m, " << cold.solver_iterations
+         << " iterations; true loops min weight " << true_min << ", false loops max weight " << false_max);
     REQUIRE(warm.optimizations == cold.optimizations);
     CHECK(warm.adopted == cold.adopted);  // after every optimisation, not only the last
     CHECK(cold.cold_restarts == 0);
