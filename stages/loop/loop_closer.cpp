@@ -138,7 +138,6 @@ void LoopCloser::run_optimization(LoopCloserOutput& out) {
   const auto t0 = Clock::now();
   const bool warm = options_.warm_start && num_optimizations_ > 0;
   last_result_ = optimizer_.optimize(options_.mode, warm ? &last_result_ : nullptr);
-  if (last_result_.cold_restart) ++num_cold_restarts_;
   out.timing.optimization_ms = ms_since(t0);
   out.optimized = true;
   ++num_optimizations_;
@@ -173,7 +172,7 @@ std::vector<RigidPose> LoopCloser::refine_with_adopted(const LoopGraphResult& re
   std::vector<LoopEdge> edges;
   const std::vector<VerifiedLoop>& loops = optimizer_.loops();
   for (const LoopResult& r : result.loops) {
-    if (!r.used || r.weight < options_.adopt_min_weight) continue;
+    if (!r.used || r.weight < options_.graph.adopted_min_weight) continue;
     const VerifiedLoop& l = loops[r.loop_index];
     edges.push_back(
         LoopEdge{node_of(l.match_t_ns), node_of(l.query_t_ns), RigidPose{l.p_mq, l.q_mq.normalized()}, 1.0});

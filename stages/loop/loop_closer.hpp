@@ -50,7 +50,7 @@ struct LoopCloserOptions {
   bool use_point_weights = true;
   float min_point_weight = 0.5f;
   /// Not in the paper: after a Dynavins optimisation, solve the pose graph once more from the odometry with
-  /// the loops of the adopted hypotheses (final weight >= adopt_min_weight) as plain unit-weight loop edges
+  /// the loops of the adopted hypotheses (final weight >= graph.adopted_min_weight) as plain unit-weight loop edges
   /// (Huber, as LoopMode::All) and every other loop left out. Eq. 16 scales each loop residual by w/|H|,
   /// so a group's |H| loops together pull like w^2/|H| of one loop edge; with the ~50 loops per group of
   /// a forward-moving camera (3 candidates per keyframe) the correction then stays partial (measured in
@@ -69,7 +69,6 @@ struct LoopCloserOptions {
   /// time). Below 8 / fraction keyframes (800 at 0.01) it never holds one back: a kept group has at least
   /// 8. The loop corrections then come up to that many keyframes later; finish() always optimises. 0: off.
   double min_new_keyframe_fraction = 0.01;
-  double adopt_min_weight = 0.5;
 };
 
 /// A loop verified at this keyframe. The group index is known only once the group closes (kept groups);
@@ -144,8 +143,6 @@ class LoopCloser {
   /// The last optimisation's result (empty before the first); with optimizer() it gives loop_report().
   const LoopGraphResult& last_result() const { return last_result_; }
   int num_optimizations() const { return num_optimizations_; }
-  /// Warm-started optimisations redone from the odometry (see LoopCloserOptions::warm_start).
-  int num_cold_restarts() const { return num_cold_restarts_; }
   const LoopCloserOptions& options() const { return options_; }
 
   /// Bytes held per keyframe entry (descriptors, points) plus the pose lists; no images.
@@ -171,7 +168,6 @@ class LoopCloser {
   std::size_t loops_at_last_optimization_ = 0;
   std::size_t keyframes_at_last_optimization_ = 0;
   int num_optimizations_ = 0;
-  int num_cold_restarts_ = 0;
 };
 
 }  // namespace dynavins::loop

@@ -181,12 +181,13 @@ LoopGraphResult LoopGraphOptimizer::optimize_dynavins(PoseGraph4Dof& graph, cons
     // if its hypotheses are unchanged, else from a weight step at the current poses. Warm-started, the
     // first round keeps the previous optimisation's weights of unchanged groups (a group new since then
     // keeps the even split: its keyframes still carry the drift gathered since).
+    const std::vector<GroupWeights>& carried = round == 0 && previous != nullptr ? previous->groups : state;
     for (std::size_t a = 0; a < next.size(); ++a) {
       if (round > 0) {
         const HypothesisWeights nw = weight_step(graph, next[a]);
         next[a].w0 = nw.w0, next[a].w1 = nw.w1;
       }
-      for (const GroupWeights& old : round > 0 ? state : previous != nullptr ? previous->groups : state)
+      for (const GroupWeights& old : carried)
         if (old.group == next[a].group && old.h0 == next[a].h0 && old.h1 == next[a].h1)
           next[a].w0 = old.w0, next[a].w1 = old.w1;
     }

@@ -27,7 +27,8 @@ struct LoopGraphOptions {
   int max_alternations = 10;       ///< weight step + pose solve pairs per round
   double weight_tolerance = 1e-3;  ///< the alternation stops when no weight moves more than this
   int max_rounds = 3;              ///< re-clusterings; stops early when the hypotheses no longer change
-  /// A loop counts as adopted at weight >= this (for the warm start's cold restart, see optimize()).
+  /// A loop counts as adopted at weight >= this (the warm start's cold restart, see optimize(); and
+  /// LoopCloserOptions::refine_adopted).
   double adopted_min_weight = 0.5;
 };
 
