@@ -84,8 +84,8 @@ struct EstimatorOptions {
   /// Ours, not the paper's: the state step of the alternation gives a kept feature (eq. 10 weight at or
   /// above the weight of a one-sigma track, 0.5 at lambda_w = 1) its full weight, as Huber does, and a
   /// rejected one its weight relative to that (feature_weights.hpp, state_step_weight). 0 (default) = the
-  /// paper's w_j^2 on every feature; off by default: it helped the fast street twins and hurt `none`
-  /// (README, "Street scenes").
+  /// paper's w_j^2 on every feature; off by default: over noise draws it helped the street scenes and
+  /// hurt `none` and `high` (README, "Street scenes").
   bool kept_full_weight = false;
   /// Ours: r_j of the weight step is the mean squared whitened residual per residual component (2 per
   /// observation), so r_j = 1 is a track at exactly the configured noise (feature_weights.hpp). 0
