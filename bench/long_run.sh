@@ -8,23 +8,28 @@
 # memory growth per keyframe and writes the report.
 # Writes bench/results/long_run[-loopMODE][-Ss]/: REPORT.md, long_run.png, summary.json, rss.csv,
 # stats.csv.gz, queues.csv.gz, loops.csv.gz, decode.txt.
-# Usage: bench/long_run.sh [--duration S] [--loop MODE] [--max-wall-min M]
+# Usage: bench/long_run.sh [--duration S] [--loop MODE] [--max-wall-min M] [--without-ground-truth]
 #   --duration S      a shorter cut of the same scene (rendered and cached apart), as a quick check
 #   --loop MODE       loop closure mode (default dynavins; off: the odometry pipeline alone)
 #   --max-wall-min M  stop the run with SIGINT after M minutes of wall time: the report then covers the
 #                     data processed until then and says so (summary.json: interrupted: true)
+#   --without-ground-truth  replay a copy of the log without its GROUND_TRUTH channel (written to a temporary
+#                     folder: 15.5 GB for the whole scene), so the memory is the pipeline's alone (a run keeps
+#                     every ground-truth state it reads, for its final ATE); the ATE is still computed after
+#                     the run, from the cached groundtruth.tum. Results go to ...-nogt.
 # Cost: rendering the scene takes 35-50 min of this 2-core machine (cached in bench/cache/long_run, 15.5 GB);
 # the run with --loop off about 10 min, with loop closure about 15 min (README "Long run").
 set -euo pipefail
 cd "$(dirname "$0")/.."
 bin=$(readlink -f "${DYNAVINS:-build/bin/dynavins}")
-duration= loop=dynavins max_wall_min=
+duration= loop=dynavins max_wall_min= without_gt=
 while [ $# -gt 0 ]; do
   case $1 in
     --duration) duration=$2; shift 2 ;;
     --loop) loop=$2; shift 2 ;;
     --max-wall-min) max_wall_min=$2; shift 2 ;;
-    *) echo "usage: bench/long_run.sh [--duration S] [--loop MODE] [--max-wall-min M]" >&2; exit 2 ;;
+    --without-ground-truth) without_gt=1; shift ;;
+    *) echo "usage: bench/long_run.sh [--duration S] [--loop MODE] [--max-wall-min M] [--without-ground-truth]" >&2; exit 2 ;;
   esac
 done
 
@@ -32,8 +37,8 @@ name=long_run sim_args=()
 if [ -n "$duration" ]; then name=long_run-${duration}s sim_args=(--duration "$duration"); fi
 DYNAVINS=$bin CACHE_AS=$name scripts/cached-sim.sh long_run "${sim_args[@]}"
 scene=bench/cache/$name
-out=bench/results/long_run${loop:+-loop$loop}${duration:+-${duration}s}
-[ "$loop" = dynavins ] && out=bench/results/long_run${duration:+-${duration}s}
+out=bench/results/long_run${loop:+-loop$loop}${duration:+-${duration}s}${without_gt:+-nogt}
+[ "$loop" = dynavins ] && out=bench/results/long_run${duration:+-${duration}s}${without_gt:+-nogt}
 tmp=$(mktemp -d)
 trap 'rm -rf "$tmp"' EXIT
 
@@ -42,7 +47,12 @@ trap 'rm -rf "$tmp"' EXIT
 "$bin" sim --scenario long_run --duration 0.5 --euroc --out "$tmp/calib" > "$tmp/calib.log" 2>&1 ||
   { cat "$tmp/calib.log"; exit 1; }
 
-"$bin" run --config "$tmp/calib/euroc/vins_config.yaml" --log "$scene/sensors.lcmlog" --rate 0 --ba dynavins \
+log=$scene/sensors.lcmlog
+if [ -n "$without_gt" ]; then
+  /usr/bin/python3 bench/report/drop_channel.py "$log" "$tmp/sensors.lcmlog" GROUND_TRUTH
+  log=$tmp/sensors.lcmlog
+fi
+"$bin" run --config "$tmp/calib/euroc/vins_config.yaml" --log "$log" --rate 0 --ba dynavins \
   --loop "$loop" --lcm-url "file://$tmp/outputs.lcmlog?mode=w" --out "$tmp/run" > "$tmp/run.log" 2>&1 &
 pid=$!
 start=$(date +%s.%N)
@@ -76,5 +86,5 @@ gzip -9 -c "$tmp/decoded/queues.csv" > "$out/queues.csv.gz"
 [ ! -f "$tmp/run/loops.csv" ] || gzip -9 -c "$tmp/run/loops.csv" > "$out/loops.csv.gz"
 /usr/bin/python3 bench/report/long_run_report.py --dir "$out" --ate-odometry "$tmp/ate_odometry.json" \
   --ate-trajectory "$tmp/ate_trajectory.json" --loop "$loop" \
-  --command "bench/long_run.sh${duration:+ --duration $duration} --loop $loop${max_wall_min:+ --max-wall-min $max_wall_min}"
+  --command "bench/long_run.sh${duration:+ --duration $duration} --loop $loop${max_wall_min:+ --max-wall-min $max_wall_min}${without_gt:+ --without-ground-truth}"
 echo "long_run: wrote $out/REPORT.md and $out/long_run.png"
