@@ -29,10 +29,11 @@
 // ŵ_j² r_j → (λw + 1)² / r_j, bounded and redescending). The weight step itself (eq. 10, momentum, the
 // reported w_j) is unchanged. Off by default, measured over noise draws (README, "Street scenes"): it
 // removes dynavins' cost on the fast static street and cuts the error behind a leading truck by a third
-// (stereo), but costs 20-25 % on our drone scenes `none` and `high`, and in mono it is worse everywhere. Measured against the simulator's truth, the
-// down-weighting is not uniform: a static track's median r_j is ~0.01 (w_j² ~ 0.98), and the kept
-// static tracks the kernel does down-weight (w_j 0.5-0.9) are mostly tracks that drifted (median true
-// error 1.7 px, a tenth above 7 px; `bench_estimator`), which the key gives full weight.
+// (stereo), but costs 20-25 % on our drone scenes `none` and `high`, and in mono it is worse everywhere.
+// Measured against the simulator's truth, the down-weighting is not uniform: a static track's median
+// r_j is ~0.01 (w_j² ~ 0.98), and the kept static tracks the kernel does down-weight (w_j 0.5-0.9) are
+// mostly tracks that drifted (median true error 1.7 px, a tenth above 7 px; `bench_estimator`), which
+// the key gives full weight.
 
 #include <vector>
 
