@@ -9,9 +9,9 @@
 #              no --b). Scenes are cached as bench/cache/NAME-seedS (scripts/cached-sim.sh).
 # Every run is `dynavins run --rate 0 --loop off` (lossless, deterministic). Writes runs to
 # bench/results/seed_sweep/ (not kept in git) and the table to stdout.
-# Example (the README's "Street scenes" table):
-#   bench/seed_sweep.sh --seeds 21,22,23,24 --a "--set kept_full_weight=0" --b "--set kept_full_weight=1" \
-#     street_none street_crowd
+# Example (the README's "Street scenes" table, seeds 22-24; bench/results/seed_sweep.md has the others):
+#   bench/seed_sweep.sh --seeds 22,23,24 --a "--set kept_full_weight=0" --b "--set kept_full_weight=1" \
+#     street_none street_crowd street_follow_none street_follow
 set -euo pipefail
 cd "$(dirname "$0")/.."
 bin=$(readlink -f "${DYNAVINS:-build/bin/dynavins}")
@@ -23,7 +23,7 @@ while [ $# -gt 0 ]; do
     --mono) mono=(--mono) ;;
     --a) a=$2; shift ;;
     --b) b=$2; have_b=1; shift ;;
-    -h|--help) sed -n '2,13p' "$0"; exit 0 ;;
+    -h|--help) sed -n '2,14p' "$0"; exit 0 ;;
     -*) echo "seed_sweep: unknown option $1" >&2; exit 2 ;;
     *) scenes+=("$1") ;;
   esac
