@@ -2,10 +2,12 @@
 #include "stages/loop/loop_closer.hpp"
 
 #include <algorithm>
+#include <cmath>
 #include <chrono>
 #include <limits>
 #include <optional>
 #include <stdexcept>
+#include <string>
 #include <utility>
 
 #include <spdlog/spdlog.h>
@@ -95,9 +97,14 @@ LoopCloserOutput LoopCloser::process(KeyframeDescriptors d, double descriptors_m
   t0 = Clock::now();
   for (const PlaceCandidate& c : candidates) {
     const LoopVerification v = verifier_.verify(d, entries_[static_cast<std::size_t>(c.keyframe_id)]);
-    spdlog::debug("loop candidate: query {} match {} score {:.3f} matches {} inliers {} -> {}", d.t_ns,
+    // The PnP pose is printed once it passed the inlier count, so an implausible one shows how far off it is.
+    const bool has_pose = v.accepted || v.rejection == LoopRejection::Implausible;
+    spdlog::debug("loop candidate: query {} match {} score {:.3f} matches {} inliers {} -> {}{}", d.t_ns,
                   entries_[static_cast<std::size_t>(c.keyframe_id)].t_ns, c.score, v.matches, v.inliers,
-                  v.accepted ? "verified" : to_string(v.rejection));
+                  v.accepted ? "verified" : to_string(v.rejection),
+                  has_pose ? fmt::format(" (|p_mq| {:.2f} m, rotation {:.1f} deg)", v.loop.p_mq.norm(),
+                                         Eigen::AngleAxisd(v.loop.q_mq).angle() * 180.0 / M_PI)
+                           : std::string());
     if (!v.accepted) continue;
     const std::size_t index = optimizer_.loops().size();
     if (!optimizer_.add_loop(v.loop)) continue;
