@@ -78,7 +78,8 @@ std::string loop_json(const LoopRunSummary& l, const LoopTruthCounts& t, bool ha
     << ", \"descriptors_ms_mean\": " << l.descriptors_ms_mean << ", \"query_ms_mean\": " << l.query_ms_mean
     << ", \"verification_ms_mean\": " << l.verification_ms_mean
     << ", \"optimization_ms_mean\": " << l.optimization_ms_mean
-    << ", \"optimization_ms_max\": " << l.optimization_ms_max << ", \"memory_kb\": " << l.memory_bytes / 1024.0;
+    << ", \"optimization_ms_max\": " << l.optimization_ms_max << ", \"memory_kb\": " << l.memory_bytes / 1024.0
+    << ", \"keyframes_released\": " << l.keyframes_released;
   if (has_truth)
     j << ", \"true_loops\": " << t.true_loops << ", \"false_loops\": " << t.false_loops
       << ", \"false_loops_used\": " << t.false_used << ", \"true_loops_used\": " << t.true_used;

@@ -102,6 +102,7 @@ LoopRunSummary LoopStage::summary() const {
   if (closer_->num_optimizations() > 0) s.optimization_ms_mean = opt_ms_sum_ / closer_->num_optimizations();
   s.optimization_ms_max = opt_ms_max_;
   s.memory_bytes = closer_->memory_bytes();
+  s.keyframes_released = static_cast<int64_t>(closer_->num_released());
   s.corrections = closer_->keyframe_corrections();
   s.loops = closer_->loops();
   if (closer_->num_optimizations() > 0) s.rows = loop::loop_report(closer_->optimizer(), closer_->last_result());

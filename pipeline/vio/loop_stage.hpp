@@ -44,6 +44,7 @@ struct LoopRunSummary {
   double descriptors_ms_mean = 0, query_ms_mean = 0, verification_ms_mean = 0, optimization_ms_mean = 0;
   double optimization_ms_max = 0;
   std::size_t memory_bytes = 0;                       ///< the keyframe database, no images
+  int64_t keyframes_released = 0;  ///< taken out of the database as revisits (LoopCloserOptions::release_revisited)
   std::vector<loop::KeyframeCorrection> corrections;  ///< per keyframe, after the final optimisation
   std::vector<VerifiedLoop> loops;                    ///< every verified loop, in detection order
   std::vector<loop::LoopReportRow> rows;              ///< per loop: group, hypothesis, final weight, used

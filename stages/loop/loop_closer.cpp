@@ -116,6 +116,7 @@ LoopCloserOutput LoopCloser::process(KeyframeDescriptors d, double descriptors_m
   odometry_.push_back(T_W_k);
   corrected_.push_back(compose(drift_, T_W_k));
   entries_.push_back(std::move(d));
+  released_.push_back(false);
 
   // IV-C: optimise once the group holding new loops has closed (its hypotheses are then complete), and
   // on a large graph not before min_new_keyframe_fraction of it is new (cost per keyframe bounded).
@@ -151,6 +152,7 @@ void LoopCloser::run_optimization(LoopCloserOutput& out) {
   corrected_ = options_.refine_adopted && options_.mode == LoopMode::Dynavins ? refine_with_adopted(last_result_)
                                                                               : last_result_.poses;
   drift_ = drift_correction(odometry_.back(), corrected_.back());
+  if (options_.release_revisited) release_revisited(last_result_);
   out.keyframe_t_ns = t_ns_;
   out.corrected = corrected_;
 
@@ -190,6 +192,22 @@ std::vector<RigidPose> LoopCloser::refine_with_adopted(const LoopGraphResult& re
   return graph.poses();
 }
 
+void LoopCloser::release_revisited(const LoopGraphResult& result) {
+  const std::vector<VerifiedLoop>& loops = optimizer_.loops();
+  for (const LoopResult& r : result.loops) {
+    if (!r.used || r.weight < options_.graph.adopted_min_weight) continue;
+    const int64_t query_t_ns = loops[r.loop_index].query_t_ns;
+    const auto k = static_cast<std::size_t>(std::lower_bound(t_ns_.begin(), t_ns_.end(), query_t_ns) - t_ns_.begin());
+    if (k >= t_ns_.size() || t_ns_[k] != query_t_ns || released_[k]) continue;
+    KeyframeDescriptors& e = entries_[k];
+    database_.remove(static_cast<int64_t>(k), vocabulary_->transform(e.descriptors));
+    e.points = std::vector<KeyframePoint>();  // move-assigned: frees the capacity too (= {} would keep it)
+    e.descriptors.release();
+    released_[k] = true;
+    ++num_released_;
+  }
+}
+
 std::vector<KeyframeCorrection> LoopCloser::keyframe_corrections() const {
   std::vector<KeyframeCorrection> c;
   c.reserve(t_ns_.size());
@@ -201,6 +219,7 @@ std::vector<KeyframeCorrection> LoopCloser::keyframe_corrections() const {
 std::size_t LoopCloser::memory_bytes() const {
   std::size_t b = sizeof(*this);
   for (const KeyframeDescriptors& e : entries_) b += e.memory_bytes();
+  b += database_.memory_bytes() + released_.capacity() / 8;
   b += t_ns_.capacity() * sizeof(int64_t) + (odometry_.capacity() + corrected_.capacity()) * sizeof(RigidPose);
   return b;
 }

@@ -69,6 +69,14 @@ struct LoopCloserOptions {
   /// time). Below 8 / fraction keyframes (800 at 0.01) it never holds one back: a kept group has at least
   /// 8. The loop corrections then come up to that many keyframes later; finish() always optimises. 0: off.
   double min_new_keyframe_fraction = 0.01;
+  /// Not in the paper: a keyframe whose loop an optimisation adopted (used, weight >= graph.adopted_min_weight)
+  /// shows a place the database already holds. It leaves the database and its descriptors and points are
+  /// dropped; it stays a pose-graph node. So on a route driven again and again the database grows with
+  /// the places seen, not with time (issue 22: keeping every keyframe, 1.4 GB after 30 minutes). Later
+  /// visits match the keyframes kept. Only adopted loops count: a keyframe whose loops were rejected
+  /// (a moved object seen elsewhere) stays, so a genuine return there later still finds it. Irreversible:
+  /// if a later optimisation rejects that loop after all, the place is still represented by the match.
+  bool release_revisited = true;
 };
 
 /// A loop verified at this keyframe. The group index is known only once the group closes (kept groups);
@@ -145,13 +153,18 @@ class LoopCloser {
   int num_optimizations() const { return num_optimizations_; }
   const LoopCloserOptions& options() const { return options_; }
 
-  /// Bytes held per keyframe entry (descriptors, points) plus the pose lists; no images.
+  /// Bytes held: per keyframe entry (descriptors, points), the database's index, the pose lists; no images.
   std::size_t memory_bytes() const;
+  /// Keyframes taken out of the database as revisits (LoopCloserOptions::release_revisited).
+  std::size_t num_released() const { return num_released_; }
+  /// Per keyframe (keyframe order): whether it was taken out of the database.
+  const std::vector<bool>& released() const { return released_; }
 
  private:
   LoopCloserOutput process(KeyframeDescriptors d, double descriptors_ms);
   void run_optimization(LoopCloserOutput& out);
   std::vector<RigidPose> refine_with_adopted(const LoopGraphResult& result) const;
+  void release_revisited(const LoopGraphResult& result);
 
   std::shared_ptr<const VocabularyTree> vocabulary_;
   LoopCloserOptions options_;
@@ -168,6 +181,8 @@ class LoopCloser {
   std::size_t loops_at_last_optimization_ = 0;
   std::size_t keyframes_at_last_optimization_ = 0;
   int num_optimizations_ = 0;
+  std::vector<bool> released_;  // per keyframe: out of the database (release_revisited)
+  std::size_t num_released_ = 0;
 };
 
 }  // namespace dynavins::loop

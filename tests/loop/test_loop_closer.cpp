@@ -9,7 +9,9 @@
 // Measured (Release): 240 verified loops, all true (worst T_m^k error 0.023 m), every lap-2 keyframe past the
 // first half side closes one; RMSE odometry 1.09 m -> all 0.12, switchable 0.12, dynavins 0.38 m (eq. 16's
 // w/|H| on ~50 loops per group), dynavins + refine_adopted 0.15 m. With the bus: 8 false loops (2.5 m off),
-// all 0.21 m, dynavins 0.37 m with the false hypothesis at w < 0.001, switchable 0.13 m. 22 kB per keyframe.
+// all 0.21 m, dynavins 0.37 m with the false hypothesis at w < 0.001, switchable 0.13 m. 22 kB per keyframe
+// kept; with release_revisited the 64 lap-2 keyframes whose loops were adopted leave the database (4.2 -> 2.5 MB),
+// and lap 2 driven once more grows the memory by 1.08x (1.49x keeping every keyframe).
 #include <algorithm>
 #include <cmath>
 #include <map>
@@ -169,6 +171,7 @@ struct Run {
   double max_keyframe_ms = 0.0;
   std::vector<KeyframeCorrection> corrections;
   std::vector<NewLoop> new_loops;  // as the per-keyframe outputs reported them
+  std::vector<bool> released;      // per keyframe: taken out of the database as a revisit
 };
 
 Run run(const World& w, const std::shared_ptr<const VocabularyTree>& vocab, LoopMode mode,
@@ -191,6 +194,7 @@ Run run(const World& w, const std::shared_ptr<const VocabularyTree>& vocab, Loop
   r.optimizations = lc.num_optimizations();
   r.memory_bytes = lc.memory_bytes();
   r.corrections = lc.keyframe_corrections();
+  r.released = lc.released();
   return r;
 }
 
@@ -429,6 +433,72 @@ TEST_CASE("LoopCloser: outputs, drift correction, memory per keyframe", "[loop][
   WARN("memory " << kb << " kB per keyframe (" << points / w.keyframes.size() << " points each)");
   CHECK(kb < 40.0);
   CHECK_THROWS_AS(lc.add_descriptors(w.keyframes.back()), std::invalid_argument);  // not newer
+}
+
+TEST_CASE("LoopCloser: revisits confirmed by adopted loops leave the database; rejected ones stay", "[loop][closer]") {
+  const World w = make_world();
+  const auto vocab = train_vocabulary(w);
+  LoopCloserOptions keep;
+  keep.release_revisited = false;
+  const Run kept = run(w, vocab, LoopMode::Dynavins, keep);
+  const Run rel = run(w, vocab, LoopMode::Dynavins);
+  std::size_t released = 0;
+  for (std::size_t k = 0; k < rel.released.size(); ++k) {
+    released += rel.released[k];
+    if (rel.released[k]) CHECK(k >= static_cast<std::size_t>(LoopScenario::kPerLap));  // only lap 2 revisits lap 1
+  }
+  WARN("released " << released << " of " << rel.released.size() << " keyframes; memory " << kept.memory_bytes / 1024
+                   << " -> " << rel.memory_bytes / 1024 << " kB");
+  CHECK(std::count(kept.released.begin(), kept.released.end(), true) == 0);
+  CHECK(static_cast<double>(released) > 0.4 * LoopScenario::kPerLap);
+  CHECK(static_cast<double>(rel.memory_bytes) < 0.85 * static_cast<double>(kept.memory_bytes));
+  // Two laps: lap-2 queries only ever match lap-1 keyframes, so the loops and the answer are the same.
+  REQUIRE(rel.loops.size() == kept.loops.size());
+  for (std::size_t k = 0; k < rel.poses.size(); ++k) CHECK((rel.poses[k].p - kept.poses[k].p).norm() < 1e-6);
+
+  // The relocated bus: a keyframe is released only for a loop its optimisation adopted, never for the
+  // false loops the weights rejected.
+  const World bus = make_world(WorldOptions{true});
+  const Run b = run(bus, train_vocabulary(bus), LoopMode::Dynavins);
+  std::map<std::size_t, bool> adopted;  // query keyframe -> one of its loops used at weight >= 0.5
+  for (const LoopResult& r : b.result.loops) {
+    const std::size_t q = index_of(bus.s, b.loops[r.loop_index].query_t_ns);
+    adopted[q] = adopted[q] || (r.used && r.weight >= 0.5);
+  }
+  int rejected_only = 0;
+  for (std::size_t k = 0; k < b.released.size(); ++k) {
+    const bool has_loops = adopted.count(k) > 0;
+    if (b.released[k]) CHECK((has_loops && adopted[k]));
+    rejected_only += has_loops && !adopted[k];
+  }
+  WARN("bus: " << false_loops(bus, b).size() << " false loops; " << rejected_only
+               << " keyframes whose loops were all rejected, none released");
+}
+
+TEST_CASE("LoopCloser: a route driven again does not grow the database", "[loop][closer]") {
+  // Laps 1 and 2, then lap 2's keyframes once more as a third lap (times shifted): with release_revisited
+  // the third lap's keyframes find lap 1 or lap 2 and leave the database too.
+  const World w = make_world();
+  const auto vocab = train_vocabulary(w);
+  for (bool release : {false, true}) {
+    LoopCloserOptions opts;
+    opts.release_revisited = release;
+    LoopCloser lc(vocab, opts);
+    for (const KeyframeDescriptors& kd : w.keyframes) lc.add_descriptors(kd);
+    const std::size_t after_two = lc.memory_bytes();
+    const int64_t shift = w.keyframes.back().t_ns - w.keyframes.front().t_ns + 100'000'000;
+    for (std::size_t k = LoopScenario::kPerLap; k < w.keyframes.size(); ++k) {
+      KeyframeDescriptors kd = w.keyframes[k];
+      kd.t_ns += shift;
+      lc.add_descriptors(kd);
+    }
+    lc.finish();
+    const double growth = static_cast<double>(lc.memory_bytes()) / static_cast<double>(after_two);
+    WARN((release ? "release_revisited" : "keep all")
+         << ": memory after the third lap " << growth << "x that after two; " << lc.num_released() << " released");
+    if (release) CHECK(growth < 1.15);
+    else CHECK(growth > 1.3);
+  }
 }
 
 TEST_CASE("LoopCloser: optimisations are spaced in proportion to the graph's size", "[loop][closer]") {

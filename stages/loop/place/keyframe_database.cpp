@@ -13,6 +13,34 @@ void KeyframeDatabase::add(int64_t keyframe_id, int64_t t_ns, const BowVector& b
     throw std::invalid_argument("KeyframeDatabase::add: keyframe " + std::to_string(keyframe_id) + " already added");
   entries_.push_back({keyframe_id, t_ns});
   for (const BowEntry& e : bow) inverted_[e.word].push_back({entry, e.weight});
+  num_postings_ += bow.size();
+}
+
+void KeyframeDatabase::remove(int64_t keyframe_id, const BowVector& bow) {
+  const auto found = index_of_id_.find(keyframe_id);
+  if (found == index_of_id_.end())
+    throw std::invalid_argument("KeyframeDatabase::remove: keyframe " + std::to_string(keyframe_id) + " was not added");
+  const uint32_t entry = found->second;
+  for (const BowEntry& e : bow) {
+    const auto it = inverted_.find(e.word);
+    if (it == inverted_.end()) continue;
+    std::vector<Posting>& postings = it->second;
+    const auto end =
+        std::remove_if(postings.begin(), postings.end(), [&](const Posting& p) { return p.entry == entry; });
+    num_postings_ -= static_cast<std::size_t>(postings.end() - end);
+    postings.erase(end, postings.end());
+    if (postings.empty()) inverted_.erase(it);
+    else if (postings.size() < postings.capacity() / 4) postings.shrink_to_fit();  // memory follows the places kept
+  }
+}
+
+std::size_t KeyframeDatabase::memory_bytes() const {
+  // Hash nodes: key, value and about two pointers each (libstdc++'s node plus its bucket).
+  std::size_t b = sizeof(*this) + entries_.capacity() * sizeof(Entry) +
+                  index_of_id_.size() * (sizeof(int64_t) + sizeof(uint32_t) + 2 * sizeof(void*));
+  for (const auto& [word, postings] : inverted_)
+    b += sizeof(word) + sizeof(postings) + 2 * sizeof(void*) + postings.capacity() * sizeof(Posting);
+  return b;
 }
 
 std::vector<PlaceCandidate> KeyframeDatabase::query(const BowVector& bow, const DatabaseQueryOptions& opts) const {

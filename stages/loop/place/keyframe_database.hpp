@@ -34,7 +34,14 @@ class KeyframeDatabase {
   /// The keyframes allowed by `opts` that share a word with `bow`, highest score first (ties: older first).
   std::vector<PlaceCandidate> query(const BowVector& bow, const DatabaseQueryOptions& opts = {}) const;
 
-  std::size_t size() const { return entries_.size(); }
+  /// Takes a keyframe out of the candidates: its postings go, `bow` must be what it was added with
+  /// (std::invalid_argument for an unknown id). Its id stays taken and it still counts for exclude_recent.
+  void remove(int64_t keyframe_id, const BowVector& bow);
+
+  std::size_t size() const { return entries_.size(); }  ///< keyframes added, removed ones included
+  std::size_t num_postings() const { return num_postings_; }
+  /// Bytes of the entries and the inverted index (capacities, hash buckets approximated).
+  std::size_t memory_bytes() const;
 
  private:
   struct Entry {
@@ -47,6 +54,7 @@ class KeyframeDatabase {
   std::vector<Entry> entries_;
   std::unordered_map<int64_t, uint32_t> index_of_id_;
   std::unordered_map<uint32_t, std::vector<Posting>> inverted_;  // word -> postings
+  std::size_t num_postings_ = 0;
 };
 
 }  // namespace dynavins::loop

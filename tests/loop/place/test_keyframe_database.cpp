@@ -67,6 +67,34 @@ TEST_CASE("keyframe database: scores are the L1 scores, best first") {
   CHECK(self.size() <= 3);
 }
 
+TEST_CASE("keyframe database: a removed keyframe is no longer a candidate, the others score the same") {
+  std::mt19937 rng(5);
+  KeyframeDatabase db;
+  std::vector<BowVector> bows;
+  for (int i = 0; i < 30; ++i) bows.push_back(random_bow(rng, 30, 200)), db.add(i, 1000 * i, bows.back());
+  const std::size_t postings = db.num_postings(), bytes = db.memory_bytes();
+  CHECK(postings == 30 * 30);
+  DatabaseQueryOptions opts;
+  opts.max_results = 100;
+  const auto before = db.query(bows[12], opts);
+  db.remove(12, bows[12]);
+  CHECK(db.num_postings() == postings - 30);
+  CHECK(db.memory_bytes() <= bytes);
+  CHECK(db.size() == 30);  // still counted for exclude_recent
+  const auto after = db.query(bows[12], opts);
+  CHECK(after.size() + 1 == before.size());
+  for (const auto& c : after) {
+    CHECK(c.keyframe_id != 12);
+    CHECK(c.score == Approx(l1_score(bows[12], bows[static_cast<std::size_t>(c.keyframe_id)])).margin(1e-12));
+  }
+  CHECK_THROWS_AS(db.remove(99, bows[0]), std::invalid_argument);
+  CHECK_THROWS(db.add(12, 0, bows[12]));  // the id stays taken
+  for (int i = 0; i < 30; ++i)
+    if (i != 12) db.remove(i, bows[static_cast<std::size_t>(i)]);
+  CHECK(db.num_postings() == 0);
+  CHECK(db.query(bows[3], opts).empty());
+}
+
 TEST_CASE("keyframe database: exclusions by time and by recency") {
   std::mt19937 rng(4);
   KeyframeDatabase db;
