@@ -58,6 +58,7 @@ LoopTruthCounts write_loops_csv(const std::string& path, const LoopRunSummary& l
       const bool is_true = err_m < kTrueLoopMaxErrorM && err_deg < kTrueLoopMaxErrorDeg;
       (is_true ? c.true_loops : c.false_loops)++;
       if (r.used && r.weight >= 0.5) ++(is_true ? c.true_used : c.false_used);
+      if (r.weight >= 0.5) ++(is_true ? c.true_adopted : c.false_adopted);
       f << ',' << (is_true ? 1 : 0) << ',' << err_m << ',' << err_deg << '\n';
     } else {
       f << ",,,\n";
@@ -79,10 +80,12 @@ std::string loop_json(const LoopRunSummary& l, const LoopTruthCounts& t, bool ha
     << ", \"verification_ms_mean\": " << l.verification_ms_mean
     << ", \"optimization_ms_mean\": " << l.optimization_ms_mean
     << ", \"optimization_ms_max\": " << l.optimization_ms_max << ", \"memory_kb\": " << l.memory_bytes / 1024.0
-    << ", \"keyframes_released\": " << l.keyframes_released;
+    << ", \"keyframes_released\": " << l.keyframes_released
+    << ", \"correction_applied\": " << (l.correction_applied ? "true" : "false");
   if (has_truth)
     j << ", \"true_loops\": " << t.true_loops << ", \"false_loops\": " << t.false_loops
-      << ", \"false_loops_used\": " << t.false_used << ", \"true_loops_used\": " << t.true_used;
+      << ", \"false_loops_used\": " << t.false_used << ", \"true_loops_used\": " << t.true_used
+      << ", \"false_loops_adopted\": " << t.false_adopted << ", \"true_loops_adopted\": " << t.true_adopted;
   j << "}";
   return j.str();
 }

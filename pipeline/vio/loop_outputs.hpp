@@ -23,6 +23,8 @@ struct LoopTruthCounts {
   int true_loops = 0, false_loops = 0;
   int false_used = 0;  ///< false loops the final optimisation used with weight >= 0.5
   int true_used = 0;   ///< true loops the final optimisation used with weight >= 0.5
+  /// Loops at weight >= 0.5, used or not (with the correction skipped as insignificant none is used).
+  int false_adopted = 0, true_adopted = 0;
 };
 
 /// Writes loops.csv to `path`; `truth` may be empty (no ground truth: the truth columns stay empty).

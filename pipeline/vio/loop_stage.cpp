@@ -103,6 +103,7 @@ LoopRunSummary LoopStage::summary() const {
   s.optimization_ms_max = opt_ms_max_;
   s.memory_bytes = closer_->memory_bytes();
   s.keyframes_released = static_cast<int64_t>(closer_->num_released());
+  s.correction_applied = closer_->num_optimizations() > 0 && !closer_->last_result().correction_skipped;
   s.corrections = closer_->keyframe_corrections();
   s.loops = closer_->loops();
   if (closer_->num_optimizations() > 0) s.rows = loop::loop_report(closer_->optimizer(), closer_->last_result());

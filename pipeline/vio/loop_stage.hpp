@@ -44,6 +44,9 @@ struct LoopRunSummary {
   double descriptors_ms_mean = 0, query_ms_mean = 0, verification_ms_mean = 0, optimization_ms_mean = 0;
   double optimization_ms_max = 0;
   std::size_t memory_bytes = 0;                       ///< the keyframe database, no images
+  /// The final optimisation moved the trajectory (false: off, no optimisation, or the correction was
+  /// insignificant against the odometry, LoopGraphOptions::skip_insignificant_correction).
+  bool correction_applied = false;
   int64_t keyframes_released = 0;  ///< taken out of the database as revisits (LoopCloserOptions::release_revisited)
   std::vector<loop::KeyframeCorrection> corrections;  ///< per keyframe, after the final optimisation
   std::vector<VerifiedLoop> loops;                    ///< every verified loop, in detection order

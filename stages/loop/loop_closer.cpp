@@ -195,7 +195,8 @@ std::vector<RigidPose> LoopCloser::refine_with_adopted(const LoopGraphResult& re
 void LoopCloser::release_revisited(const LoopGraphResult& result) {
   const std::vector<VerifiedLoop>& loops = optimizer_.loops();
   for (const LoopResult& r : result.loops) {
-    if (!r.used || r.weight < options_.graph.adopted_min_weight) continue;
+    // Adopted by its weight: also when the correction was not applied (skip_insignificant_correction).
+    if (r.weight < options_.graph.adopted_min_weight) continue;
     const int64_t query_t_ns = loops[r.loop_index].query_t_ns;
     const auto k = static_cast<std::size_t>(std::lower_bound(t_ns_.begin(), t_ns_.end(), query_t_ns) - t_ns_.begin());
     if (k >= t_ns_.size() || t_ns_[k] != query_t_ns || released_[k]) continue;

@@ -69,7 +69,7 @@ struct LoopCloserOptions {
   /// time). Below 8 / fraction keyframes (800 at 0.01) it never holds one back: a kept group has at least
   /// 8. The loop corrections then come up to that many keyframes later; finish() always optimises. 0: off.
   double min_new_keyframe_fraction = 0.01;
-  /// Not in the paper: a keyframe whose loop an optimisation adopted (used, weight >= graph.adopted_min_weight)
+  /// Not in the paper: a keyframe whose loop an optimisation adopted (weight >= graph.adopted_min_weight)
   /// shows a place the database already holds. It leaves the database and its descriptors and points are
   /// dropped; it stays a pose-graph node. So on a route driven again and again the database grows with
   /// the places seen, not with time (issue 22: keeping every keyframe, 1.4 GB after 30 minutes). Later

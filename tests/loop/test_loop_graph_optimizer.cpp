@@ -116,6 +116,40 @@ TEST_CASE("LoopGraphOptimizer: a persistent false hypothesis bends `all`, not `d
   CHECK(rmse_dyn < 1.1 * ref_rmse);
 }
 
+TEST_CASE("LoopGraphOptimizer: a correction the loops cannot tell from their own error is not applied",
+          "[loop][optimizer]") {
+  // Odometry that drifts 1000x less than the default scenario's (its true loops then agree with it far
+  // inside the loop edges' 0.1 m / 1 deg): dynavins adopts the loops but keeps the odometry. With the
+  // default scenario's drift the same loops are applied.
+  for (const bool small_drift : {true, false}) {
+    LoopScenario s = small_drift ? LoopScenario(0.00012 * dynavins::loop::test::kDeg, 1.00003, 0.000003) : LoopScenario();
+    for (int j = 0; j < 8; ++j) s.add_true_loops_in_group(j);
+    const LoopGraphOptimizer opt = make_optimizer(s);
+    const LoopGraphResult r = opt.optimize(LoopMode::Dynavins);
+    WARN((small_drift ? "small drift" : "default drift") << ": chi2 " << r.odometry_chi2 << " over "
+                                                         << r.adopted_loops << " adopted loops, skipped "
+                                                         << r.correction_skipped);
+    REQUIRE(r.adopted_loops == static_cast<int>(s.loops.size()));  // every true loop adopted either way
+    for (const LoopResult& l : r.loops) CHECK(l.weight > 0.9);
+    CHECK(r.correction_skipped == small_drift);
+    if (small_drift) {
+      for (std::size_t k = 0; k < s.odom.size(); ++k) CHECK((r.poses[k].p - s.odom[k].p).norm() == 0.0);
+      for (const LoopResult& l : r.loops) CHECK(!l.used);
+    } else {
+      CHECK(s.rmse(r.poses) < 0.35 * s.rmse(s.odom));
+    }
+    // The baselines are VINS-Fusion's and Suenderhauf's: never skipped.
+    CHECK(!opt.optimize(LoopMode::All).correction_skipped);
+    LoopGraphOptions keep;
+    keep.skip_insignificant_correction = false;
+    LoopGraphOptimizer always(keep);
+    for (std::size_t k = 0; k < s.t_ns.size(); ++k) always.add_keyframe(s.t_ns[k], s.odom[k]);
+    for (const KeyframeGroup& g : s.groups) REQUIRE(always.add_group(g));
+    for (const VerifiedLoop& l : s.loops) REQUIRE(always.add_loop(l));
+    CHECK(!always.optimize(LoopMode::Dynavins).correction_skipped);
+  }
+}
+
 TEST_CASE("LoopGraphOptimizer: equal-sized hypotheses, loops outside groups, and the loops.csv report",
           "[loop][optimizer]") {
   // Lap-2 group 6 gets 3 true and 3 false loops (equal cardinality); one more true loop has its query in

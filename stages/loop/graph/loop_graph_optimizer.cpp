@@ -43,6 +43,13 @@ namespace {
 RigidPose relative_of(const VerifiedLoop& l) { return RigidPose{l.p_mq, l.q_mq.normalized()}; }
 
 /// True when some group holding loops from index `first_new` on has none of its loops adopted.
+/// 95 % quantile of a chi-square with k degrees of freedom (Wilson-Hilferty; within 1 % from k = 4 on).
+double chi_square_quantile_95(int k) {
+  const double a = 2.0 / (9.0 * k);
+  const double c = 1.0 - a + 1.6448536269514722 * std::sqrt(a);
+  return k * c * c * c;
+}
+
 bool rejects_a_new_group(const LoopGraphResult& r, std::size_t first_new, double min_weight) {
   std::vector<int> new_groups;
   for (std::size_t l = first_new; l < r.loops.size(); ++l)
@@ -77,7 +84,22 @@ LoopGraphResult LoopGraphOptimizer::optimize(LoopMode mode, const LoopGraphResul
     result.cold_restart = true;
     result.solver_iterations += warm_iterations;
   }
+  if (mode == LoopMode::Dynavins && options_.skip_insignificant_correction) keep_odometry_if_consistent(result);
   return result;
+}
+
+void LoopGraphOptimizer::keep_odometry_if_consistent(LoopGraphResult& result) const {
+  const PoseGraph4Dof at_odometry(odometry_, options_.graph);
+  for (const LoopResult& r : result.loops) {
+    if (!r.used || r.weight < options_.adopted_min_weight) continue;
+    const LoopNodes& n = loop_nodes_[r.loop_index];
+    result.odometry_chi2 += at_odometry.loop_residual_sq(LoopEdge{n.match, n.query, relative_of(loops_[r.loop_index]), 1.0});
+    ++result.adopted_loops;
+  }
+  if (result.adopted_loops == 0 || result.odometry_chi2 > chi_square_quantile_95(4 * result.adopted_loops)) return;
+  result.poses = odometry_;
+  result.correction_skipped = true;
+  for (LoopResult& r : result.loops) r.used = false;
 }
 
 LoopGraphResult LoopGraphOptimizer::optimize_from(const LoopGraphResult* previous, LoopMode mode) const {
