@@ -122,13 +122,13 @@ TEST_CASE("LoopGraphOptimizer: a correction the loops cannot tell from their own
   // inside the loop edges' 0.1 m / 1 deg): dynavins adopts the loops but keeps the odometry. With the
   // default scenario's drift the same loops are applied.
   for (const bool small_drift : {true, false}) {
-    LoopScenario s = small_drift ? LoopScenario(0.00012 * dynavins::loop::test::kDeg, 1.00003, 0.000003) : LoopScenario();
+    LoopScenario s =
+        small_drift ? LoopScenario(0.00012 * dynavins::loop::test::kDeg, 1.00003, 0.000003) : LoopScenario();
     for (int j = 0; j < 8; ++j) s.add_true_loops_in_group(j);
     const LoopGraphOptimizer opt = make_optimizer(s);
     const LoopGraphResult r = opt.optimize(LoopMode::Dynavins);
-    WARN((small_drift ? "small drift" : "default drift") << ": chi2 " << r.odometry_chi2 << " over "
-                                                         << r.adopted_loops << " adopted loops, skipped "
-                                                         << r.correction_skipped);
+    WARN((small_drift ? "small drift" : "default drift") << ": chi2 " << r.odometry_chi2 << " over " << r.adopted_loops
+                                                         << " adopted loops, skipped " << r.correction_skipped);
     REQUIRE(r.adopted_loops == static_cast<int>(s.loops.size()));  // every true loop adopted either way
     for (const LoopResult& l : r.loops) CHECK(l.weight > 0.9);
     CHECK(r.correction_skipped == small_drift);

@@ -93,7 +93,8 @@ void LoopGraphOptimizer::keep_odometry_if_consistent(LoopGraphResult& result) co
   for (const LoopResult& r : result.loops) {
     if (!r.used || r.weight < options_.adopted_min_weight) continue;
     const LoopNodes& n = loop_nodes_[r.loop_index];
-    result.odometry_chi2 += at_odometry.loop_residual_sq(LoopEdge{n.match, n.query, relative_of(loops_[r.loop_index]), 1.0});
+    result.odometry_chi2 +=
+        at_odometry.loop_residual_sq(LoopEdge{n.match, n.query, relative_of(loops_[r.loop_index]), 1.0});
     ++result.adopted_loops;
   }
   if (result.adopted_loops == 0 || result.odometry_chi2 > chi_square_quantile_95(4 * result.adopted_loops)) return;
