@@ -460,10 +460,10 @@ TEST_CASE("LoopCloser: revisits confirmed by adopted loops leave the database; r
   // false loops the weights rejected.
   const World bus = make_world(WorldOptions{true});
   const Run b = run(bus, train_vocabulary(bus), LoopMode::Dynavins);
-  std::map<std::size_t, bool> adopted;  // query keyframe -> one of its loops used at weight >= 0.5
+  std::map<std::size_t, bool> adopted;  // query keyframe -> one of its loops at weight >= 0.5
   for (const LoopResult& r : b.result.loops) {
     const std::size_t q = index_of(bus.s, b.loops[r.loop_index].query_t_ns);
-    adopted[q] = adopted[q] || (r.used && r.weight >= 0.5);
+    adopted[q] = adopted[q] || r.weight >= 0.5;
   }
   int rejected_only = 0;
   for (std::size_t k = 0; k < b.released.size(); ++k) {
