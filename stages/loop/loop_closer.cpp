@@ -175,9 +175,7 @@ void LoopCloser::run_optimization(LoopCloserOutput& out) {
 }
 
 std::vector<RigidPose> LoopCloser::refine_with_adopted(const LoopGraphResult& result) const {
-  auto node_of = [&](int64_t t) {
-    return static_cast<int>(std::lower_bound(t_ns_.begin(), t_ns_.end(), t) - t_ns_.begin());
-  };
+  auto node_of = [&](int64_t t) { return static_cast<int>(keyframe_index(t)); };
   std::vector<LoopEdge> edges;
   const std::vector<VerifiedLoop>& loops = optimizer_.loops();
   for (const LoopResult& r : result.loops) {
@@ -197,16 +195,22 @@ void LoopCloser::release_revisited(const LoopGraphResult& result) {
   for (const LoopResult& r : result.loops) {
     // Adopted by its weight: also when the correction was not applied (skip_insignificant_correction).
     if (r.weight < options_.graph.adopted_min_weight) continue;
-    const int64_t query_t_ns = loops[r.loop_index].query_t_ns;
-    const auto k = static_cast<std::size_t>(std::lower_bound(t_ns_.begin(), t_ns_.end(), query_t_ns) - t_ns_.begin());
-    if (k >= t_ns_.size() || t_ns_[k] != query_t_ns || released_[k]) continue;
+    const std::size_t k = keyframe_index(loops[r.loop_index].query_t_ns);
+    if (released_[k]) continue;
     KeyframeDescriptors& e = entries_[k];
     database_.remove(static_cast<int64_t>(k), vocabulary_->transform(e.descriptors));
     e.points = std::vector<KeyframePoint>();  // move-assigned: frees the capacity too (= {} would keep it)
     e.descriptors.release();
     released_[k] = true;
-    ++num_released_;
   }
+}
+
+std::size_t LoopCloser::keyframe_index(int64_t t_ns) const {
+  return static_cast<std::size_t>(std::lower_bound(t_ns_.begin(), t_ns_.end(), t_ns) - t_ns_.begin());
+}
+
+std::size_t LoopCloser::num_released() const {
+  return static_cast<std::size_t>(std::count(released_.begin(), released_.end(), true));
 }
 
 std::vector<KeyframeCorrection> LoopCloser::keyframe_corrections() const {

@@ -156,7 +156,7 @@ class LoopCloser {
   /// Bytes held: per keyframe entry (descriptors, points), the database's index, the pose lists; no images.
   std::size_t memory_bytes() const;
   /// Keyframes taken out of the database as revisits (LoopCloserOptions::release_revisited).
-  std::size_t num_released() const { return num_released_; }
+  std::size_t num_released() const;
   /// Per keyframe (keyframe order): whether it was taken out of the database.
   const std::vector<bool>& released() const { return released_; }
 
@@ -165,6 +165,8 @@ class LoopCloser {
   void run_optimization(LoopCloserOutput& out);
   std::vector<RigidPose> refine_with_adopted(const LoopGraphResult& result) const;
   void release_revisited(const LoopGraphResult& result);
+  /// Index of a keyframe of this closer by its time (loops only join keyframes it holds).
+  std::size_t keyframe_index(int64_t t_ns) const;
 
   std::shared_ptr<const VocabularyTree> vocabulary_;
   LoopCloserOptions options_;
@@ -182,7 +184,6 @@ class LoopCloser {
   std::size_t keyframes_at_last_optimization_ = 0;
   int num_optimizations_ = 0;
   std::vector<bool> released_;  // per keyframe: out of the database (release_revisited)
-  std::size_t num_released_ = 0;
 };
 
 }  // namespace dynavins::loop
