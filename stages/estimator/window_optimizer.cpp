@@ -282,9 +282,14 @@ class StateSolver {
     so_.max_solver_time_in_seconds = std::max(1e-3, time_left_);
     ceres::Solver::Summary summary;
     ceres::Solve(so_, &problem_, &summary);
-    const int used = summary.num_successful_steps + summary.num_unsuccessful_steps;
-    st_.ceres_iterations += used;
-    budget_ -= std::max(1, used);
+    // Iterations taken: summary.iterations[0] is the start point, not an iteration. The budget is
+    // charged one more per call, for that start (an evaluation of every residual and Jacobian, as an
+    // iteration costs; Ceres counts it in num_successful_steps, which is how this was charged before it
+    // was noticed). So with a budget of 8 the alternation makes at most 2 state solves of 4 + 2
+    // iterations where huber's one call makes 8 (issue 23, README "Street scenes").
+    const int taken = std::max(0, static_cast<int>(summary.iterations.size()) - 1);
+    st_.ceres_iterations += taken;
+    budget_ -= taken + 1;
     time_left_ -= summary.total_time_in_seconds;
     ++st_.alternations;
     return summary.termination_type == ceres::CONVERGENCE;
