@@ -21,8 +21,8 @@ using dynavins::loop::test::LoopScenario;
 
 namespace {
 
-LoopGraphOptimizer make_optimizer(const LoopScenario& s) {
-  LoopGraphOptimizer opt;  // defaults (DESIGN.md §1, PoseGraphOptions)
+LoopGraphOptimizer make_optimizer(const LoopScenario& s, const LoopGraphOptions& o = {}) {
+  LoopGraphOptimizer opt(o);  // defaults (DESIGN.md §1, PoseGraphOptions) unless given
   for (std::size_t k = 0; k < s.t_ns.size(); ++k) opt.add_keyframe(s.t_ns[k], s.odom[k]);
   for (const KeyframeGroup& g : s.groups) REQUIRE(opt.add_group(g));
   for (const VerifiedLoop& l : s.loops) REQUIRE(opt.add_loop(l));
@@ -142,11 +142,7 @@ TEST_CASE("LoopGraphOptimizer: a correction the loops cannot tell from their own
     CHECK(!opt.optimize(LoopMode::All).correction_skipped);
     LoopGraphOptions keep;
     keep.skip_insignificant_correction = false;
-    LoopGraphOptimizer always(keep);
-    for (std::size_t k = 0; k < s.t_ns.size(); ++k) always.add_keyframe(s.t_ns[k], s.odom[k]);
-    for (const KeyframeGroup& g : s.groups) REQUIRE(always.add_group(g));
-    for (const VerifiedLoop& l : s.loops) REQUIRE(always.add_loop(l));
-    CHECK(!always.optimize(LoopMode::Dynavins).correction_skipped);
+    CHECK(!make_optimizer(s, keep).optimize(LoopMode::Dynavins).correction_skipped);
   }
 }
 

@@ -42,7 +42,6 @@ bool LoopGraphOptimizer::add_loop(const VerifiedLoop& loop) {
 namespace {
 RigidPose relative_of(const VerifiedLoop& l) { return RigidPose{l.p_mq, l.q_mq.normalized()}; }
 
-/// True when some group holding loops from index `first_new` on has none of its loops adopted.
 /// 95 % quantile of a chi-square with k degrees of freedom (Wilson-Hilferty; within 1 % from k = 4 on).
 double chi_square_quantile_95(int k) {
   const double a = 2.0 / (9.0 * k);
@@ -50,6 +49,7 @@ double chi_square_quantile_95(int k) {
   return k * c * c * c;
 }
 
+/// True when some group holding loops from index `first_new` on has none of its loops adopted.
 bool rejects_a_new_group(const LoopGraphResult& r, std::size_t first_new, double min_weight) {
   std::vector<int> new_groups;
   for (std::size_t l = first_new; l < r.loops.size(); ++l)
