@@ -46,6 +46,7 @@ WindowSolveOptions solve_options(const EstimatorOptions& o, const EstimatorMode&
   s.weighted_huber = o.weighted_huber;
   s.weights.kept_full_weight = o.kept_full_weight;
   s.weights.residual_per_component = o.residual_per_component;
+  s.mono_max_depth_baselines = o.mono_max_depth_baselines;
   return s;
 }
 

@@ -112,6 +112,7 @@ struct FeatureGeometry {
   Eigen::Vector3d bearing;  ///< anchor cam0, z = 1
   std::vector<Obs> obs;
   double sqrt_info = 1;
+  double inverse_depth = 0;  ///< the best fit of the last feature_residual_with()
 
   Eigen::Vector2d residual(const Obs& o, double rho) const {
     const Eigen::Vector3d p_w = anchor.R * (bearing / rho) + anchor.p;
@@ -144,6 +145,12 @@ struct FeatureGeometry {
     }
     return rho;
   }
+  /// Largest distance from the anchor camera to a camera of the observations [m].
+  double baseline() const {
+    double b = 0;
+    for (const Obs& o : obs) b = std::max(b, (o.cam.p - anchor.p).norm());
+    return b;
+  }
 };
 
 /// feature_residual() with the camera poses from `camera(slot, cam)` and `g` as reusable scratch.
@@ -166,7 +173,35 @@ double feature_residual_with(const WindowFeature& f, const WindowSolveOptions& o
     if (k > 0) g.obs.push_back({camera(j, 0), f.obs[k].xy, true});
     if (opt.stereo && f.obs[k].has_right) g.obs.push_back({camera(j, 1), f.obs[k].xy_right, k > 0});
   }
-  return g.weighted_mean(g.best_inverse_depth(f.inv_depth), opt.weights);
+  g.inverse_depth = g.best_inverse_depth(f.inv_depth);
+  return g.weighted_mean(g.inverse_depth, opt.weights);
+}
+
+/// Mono: did the track show no parallax where the window's typical point would have? With `g` filled by
+/// feature_residual_with() and K = `max_depth_baselines`: its best-fit depth is beyond K times the
+/// baseline b it was seen over (parallax under 1/K rad) while the window's median depth is within K b.
+/// Such a track carries no depth the window can observe, and a point moving with the camera (a truck
+/// leading it) looks exactly like one at infinity: its bearing keeps still while the camera drives.
+/// Used at eq. 10's weight ~1, the truck's tracks (half the image) pulled the attitude and with it the
+/// gravity the accelerometer subtracts, and the scale crept (README, "Street scenes"); the state step
+/// now leaves them out (ŵ = 0, and out of the prior). A far static point loses only rotation, which the
+/// gyroscope gives over a window. The median condition leaves the features alone where the whole
+/// window lacks parallax (at rest, or creeping): there a still track is no evidence of anything.
+bool depth_unobservable(const FeatureGeometry& g, double max_depth_baselines, double median_depth) {
+  const double reach = max_depth_baselines * g.baseline();  // K b [m]
+  return max_depth_baselines > 0 && median_depth < reach && g.inverse_depth * reach < 1.0;
+}
+
+/// Median depth of the features the last state step used (ŵ >= 0.5; from their inverse depth in the anchor
+/// frame), so that the tracks it left out, which the truck's are, do not set it; 0 when there are none.
+double median_kept_depth(const std::vector<WindowFeature*>& features) {
+  std::vector<double> d;
+  d.reserve(features.size());
+  for (const WindowFeature* f : features)
+    if (f->inv_depth > 0 && f->state_weight >= 0.5) d.push_back(1.0 / f->inv_depth);
+  if (d.empty()) return 0.0;
+  std::nth_element(d.begin(), d.begin() + d.size() / 2, d.end());
+  return d[d.size() / 2];
 }
 
 }  // namespace
@@ -319,12 +354,16 @@ class WeightStep {
     for (int k = 0; k <= newest_; ++k) cameras_[k] = {s_.camera(k, 0), s_.camera(k, 1)};
     auto camera = [this](int k, int c) -> const CameraPose& { return cameras_[k][c]; };
     int settled = 0;
+    const double depth_median = opt_.stereo ? 0.0 : median_kept_depth(features);
     for (WindowFeature* f : features) {
       const double r = feature_residual_with(*f, opt_, camera, geometry_);
       const double w = solve_feature_weight(r, f->weight_prev, f->times_solved, opt_.weights);
       if (std::abs(w - f->weight) < opt_.settle_tolerance) ++settled;
       f->weight = w;
-      f->state_weight = state_step_weight(w, opt_.weights);
+      // eq. 10 keeps such a track (it fits a point at infinity); it only stays out of the state step.
+      const bool unobservable =
+          !opt_.stereo && depth_unobservable(geometry_, opt_.mono_max_depth_baselines, depth_median);
+      f->state_weight = unobservable ? 0.0 : state_step_weight(w, opt_.weights);
     }
     st_.weight_ms += ms_since(t0);
     return features.empty() ? 1.0 : static_cast<double>(settled) / features.size();
@@ -400,7 +439,8 @@ void WindowOptimizer::marginalize_oldest(WindowState& s, int newest, WindowFeatu
   for (auto& [id, f] : features.all()) {
     if (f.start_slot != 0 || !f.in_ba()) continue;
     // A feature the robust BA rejected would poison the prior forever (paper III; margin_feature_thresh).
-    if (opt_.loss == BaLoss::Dynavins && f.weight < opt_.margin_feature_thresh) continue;
+    // So would a mono track the state step left out for want of parallax (ŵ = 0, depth_unobservable).
+    if (opt_.loss == BaLoss::Dynavins && (f.weight < opt_.margin_feature_thresh || f.state_weight == 0.0)) continue;
     for (VisualResidual& r : visual_residuals(s, f, opt_)) {
       std::vector<int> drop{static_cast<int>(r.blocks.size()) - 1};  // the inverse depth
       if (r.anchor_block >= 0) drop.push_back(r.anchor_block);

@@ -35,6 +35,10 @@ struct WindowSolveOptions {
   double margin_feature_thresh = 0.1;  ///< features under this weight stay out of the prior (dynavins)
   bool weighted_huber = true;  ///< dynavins: Huber loss on each weighted observation too (not the paper's)
   double zero_velocity_sigma = 0.01;  ///< m/s, of the zero-velocity factor on slots found at rest
+  /// Ours (dynavins, mono only; 0 = off): a feature whose best-fit depth is more than this many times
+  /// the largest distance between its anchor camera and the others that saw it in the window (parallax
+  /// under 1/K rad) gets weight 0 in the weight step (key mono_max_depth_baselines).
+  double mono_max_depth_baselines = 30.0;
 };
 
 class WindowOptimizer {

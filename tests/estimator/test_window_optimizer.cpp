@@ -34,6 +34,10 @@ struct WindowSetup {
   double pose_offset_deg = 0.1;    ///< and rotated by about this much
   int times_solved = 0;            ///< n_j of every feature (w̄_j = 1)
   uint64_t seed = 11;
+  bool mono = false;                ///< no right observations
+  double static_depth_scale = 1.0;  ///< static points at 3-10 m times this
+  /// Points that translate with the camera (a truck leading it at its speed), seen in every slot; made last.
+  int riders = 0;
 };
 
 /// A window with its ground truth. Slot 0 starts at the truth; the gauge (position and yaw of slot 0)
@@ -113,10 +117,10 @@ SyntheticWindow::SyntheticWindow(const WindowSetup& setup) {
     f.start_slot = start;
     for (int k = start; k <= end; ++k) {
       FeatureObservation o;
-      if (!project(point(k), k, 0, o.xy) || !project(point(k), k, 1, o.xy_right)) return false;
+      if (!project(point(k), k, 0, o.xy) || (!setup.mono && !project(point(k), k, 1, o.xy_right))) return false;
       o.xy += sigma * Eigen::Vector2d(n01(rng), n01(rng));
       o.xy_right += sigma * Eigen::Vector2d(n01(rng), n01(rng));
-      o.has_right = true;
+      o.has_right = !setup.mono;
       f.obs.push_back(o);
     }
     // Depth as stereo triangulation in the anchor would give it (within a few percent).
@@ -135,7 +139,7 @@ SyntheticWindow::SyntheticWindow(const WindowSetup& setup) {
   int64_t id = 0;
   for (int made = 0; made < setup.static_features;) {
     // 3-10 m ahead of the middle camera; anchored in slots 0-3, seen to the newest slot.
-    const double z = 3.0 + 7.0 * 0.5 * (u(rng) + 1.0);
+    const double z = setup.static_depth_scale * (3.0 + 7.0 * 0.5 * (u(rng) + 1.0));
     const Eigen::Vector3d p_w = R_mid * Eigen::Vector3d(0.6 * u(rng) * z, 0.4 * u(rng) * z, z) + p_mid;
     const int start = made % 4;
     if (addTrack(id, start, kWindowSize, [&p_w](int) { return p_w; })) ++made;
@@ -152,6 +156,16 @@ SyntheticWindow::SyntheticWindow(const WindowSetup& setup) {
     const double speed = 0.3 + 0.5 * 0.5 * (u(rng) + 1.0);
     const Eigen::Vector3d step = speed * (R_a * Eigen::Vector3d(side, 0.2 * u(rng), 0.2 * u(rng))).normalized();
     if (addTrack(id, start, start + length - 1, [&](int k) { return Eigen::Vector3d(p0 + (k - start) * step); })) {
+      moving_ids.insert(id);
+      ++made;
+    }
+    ++id;
+  }
+  for (int made = 0; made < setup.riders;) {
+    // 3-4 m ahead of the first camera, then moved with the camera's position (not its rotation): exactly
+    // what a point at infinity looks like.
+    const Eigen::Vector3d offset = scenario.R_wc(0) * Eigen::Vector3d(0.5 * u(rng), 0.3 * u(rng), 3.5 + 0.5 * u(rng));
+    if (addTrack(id, 0, kWindowSize, [&](int k) { return Eigen::Vector3d(scenario.p_wc(k) + offset); })) {
       moving_ids.insert(id);
       ++made;
     }
@@ -309,4 +323,63 @@ TEST_CASE("a feature the robust BA rejected (weight < margin_feature_thresh) sta
   CHECK(relativeDifference(kept, without) > 1e-3);
   // Huber ignores the weights: the same feature is part of its prior.
   CHECK(relativeDifference(priorWith(BaLoss::Huber, 0.05), priorWith(BaLoss::Huber, -1.0)) > 1e-3);
+}
+
+TEST_CASE(
+    "mono: a track that keeps its bearing while the camera drives stays out of the state step "
+    "(mono_max_depth_baselines)",
+    "[estimator][window_optimizer]") {
+  // Points riding with the camera (a truck leading it) fit a point at infinity within the noise, so eq. 10
+  // keeps them; the static points, 3-10 m away, show the parallax of the window's baseline. The state step
+  // weight ŵ_j is what the reprojection factors and the prior read.
+  WindowSetup setup;
+  setup.mono = true;
+  setup.moving_features = 0;
+  setup.riders = 15;
+  for (const double k : {30.0, 0.0}) {
+    INFO("mono_max_depth_baselines " << k);
+    SyntheticWindow w(setup);
+    WindowSolveOptions o = solve_options(BaLoss::Dynavins);
+    o.stereo = false;
+    o.mono_max_depth_baselines = k;
+    WindowOptimizer(o).solve(w.state, w.newest(), w.features);
+    int riders = 0, riders_kept = 0;
+    for (const auto& [id, f] : w.features.all()) {
+      INFO("feature " << id << (w.moving(id) ? " (rider)" : " (static)") << " weight " << f.weight
+                      << ", state step weight " << f.state_weight);
+      if (!w.moving(id)) {
+        CHECK(f.weight > 0.9);
+        CHECK(f.state_weight > 0.9);
+      } else {
+        ++riders;
+        riders_kept += f.state_weight > 0.5;
+        if (k > 0) CHECK(f.state_weight == 0.0);
+      }
+    }
+    CHECK(riders == setup.riders);
+    // Without the rule some pass for points at infinity (6 of 15 here; the others' BA depth went behind
+    // the camera in the first state solve, where the weight step's depth fit cannot follow).
+    if (k == 0) CHECK(riders_kept > 0);
+  }
+}
+
+TEST_CASE("mono: where the whole window shows no parallax, nothing is judged by mono_max_depth_baselines",
+          "[estimator][window_optimizer]") {
+  // The static points 100x farther away (300-1000 m): every track is deeper than 30 baselines, and so is the
+  // window's median, so the rule leaves every feature in the state step (a camera at rest is this case: no
+  // baseline at all).
+  WindowSetup setup;
+  setup.mono = true;
+  setup.moving_features = 0;
+  setup.static_depth_scale = 100.0;
+  SyntheticWindow w(setup);
+  WindowSolveOptions o = solve_options(BaLoss::Dynavins);
+  o.stereo = false;
+  REQUIRE(o.mono_max_depth_baselines == 30.0);
+  WindowOptimizer(o).solve(w.state, w.newest(), w.features);
+  for (const auto& [id, f] : w.features.all()) {
+    INFO("feature " << id << " weight " << f.weight << ", state step weight " << f.state_weight);
+    CHECK(f.weight > 0.9);
+    CHECK(f.state_weight > 0.9);
+  }
 }
