@@ -57,7 +57,7 @@ const std::vector<OptionSpec>& option_specs() {
       {"weighted_huber", &O::weighted_huber, {}, "", "Huber loss under the weights (ours); 0 = the paper's eq. 4"},
       {"kept_full_weight", &O::kept_full_weight, {}, "", "1: kept features at full weight in the state step (ours, issue 23; off: mixed result, README); 0 = w_j^2 (eq. 11)"},
       {"residual_per_component", &O::residual_per_component, {}, "", "1: r_j per residual component, in units of the configured noise (ours, issue 23; off: mixed result, README); 0 = per observation"},
-      {"mono_max_depth_baselines", &O::mono_max_depth_baselines, {0, 1000}, "", "mono: weight 0 for a track deeper than this many times its baseline while the window's median kept depth is within it (ours, issue 23); 0 = off"},
+      {"mono_max_depth_baselines", &O::mono_max_depth_baselines, {0, 1000}, "", "mono: a track deeper than this many times its baseline, while the median depth of the tracks in use is within that, stays out of the state step (ours, issue 23); 0 = off"},
       {"zupt", &O::zupt, {}, "", "zero-velocity update (ours, OpenVINS' keys)"},
       {"zupt_max_velocity", &O::zupt_max_velocity, {0, 10}, "m/s", "at rest only below this speed of the last solve"},
       {"zupt_max_disparity", &O::zupt_max_disparity, {0, 50}, "px", "at rest only below this median rotation-compensated motion"},

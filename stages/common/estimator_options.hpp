@@ -93,9 +93,10 @@ struct EstimatorOptions {
   /// off by default for the same measured reason as kept_full_weight.
   bool residual_per_component = false;
   /// Ours (dynavins, mono only; 0 = off): a track whose best-fit depth is beyond K times the baseline it
-  /// was seen over, while the window's median kept depth is within K times that baseline, gets weight 0:
-  /// its depth is not observable, and a point moving with the camera looks exactly like it (window_optimizer.cpp,
-  /// depth_unobservable; README, "Street scenes"). 30 = a parallax of 1.9 deg.
+  /// was seen over, while the median depth of the tracks in use is within K times that baseline, stays out
+  /// of the state step and the prior (its weight stays eq. 10's): its depth is not observable, and a point
+  /// moving with the camera looks exactly like it (window_optimizer.cpp, depth_unobservable; README,
+  /// "Street scenes"). 30 = a parallax of 1.9 deg.
   double mono_max_depth_baselines = 30.0;
   /// Ours, not the paper's: zero-velocity update (standstill_detector.hpp), with OpenVINS' key names and
   /// defaults. A frame whose kept features show less than `zupt_max_disparity` px of rotation-compensated

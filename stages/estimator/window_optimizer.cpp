@@ -179,7 +179,8 @@ double feature_residual_with(const WindowFeature& f, const WindowSolveOptions& o
 
 /// Mono: did the track show no parallax where the window's typical point would have? With `g` filled by
 /// feature_residual_with() and K = `max_depth_baselines`: its best-fit depth is beyond K times the
-/// baseline b it was seen over (parallax under 1/K rad) while the window's median depth is within K b.
+/// baseline b it was seen over (parallax under 1/K rad) while `median_depth`, that of the tracks in use,
+/// is within K b.
 /// Such a track carries no depth the window can observe, and a point moving with the camera (a truck
 /// leading it) looks exactly like one at infinity: its bearing keeps still while the camera drives.
 /// Used at eq. 10's weight ~1, the truck's tracks (half the image) pulled the attitude and with it the

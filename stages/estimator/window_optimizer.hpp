@@ -37,7 +37,8 @@ struct WindowSolveOptions {
   double zero_velocity_sigma = 0.01;  ///< m/s, of the zero-velocity factor on slots found at rest
   /// Ours (dynavins, mono only; 0 = off): a feature whose best-fit depth is more than this many times
   /// the largest distance between its anchor camera and the others that saw it in the window (parallax
-  /// under 1/K rad) gets weight 0 in the weight step (key mono_max_depth_baselines).
+  /// under 1/K rad), while the median depth of the features in use is within that reach, stays out of the
+  /// state step and the prior (ŵ_j = 0; key mono_max_depth_baselines; window_optimizer.cpp).
   double mono_max_depth_baselines = 30.0;
 };
 

@@ -357,8 +357,8 @@ TEST_CASE(
       }
     }
     CHECK(riders == setup.riders);
-    // Without the rule some pass for points at infinity (6 of 15 here; the others' BA depth went behind
-    // the camera in the first state solve, where the weight step's depth fit cannot follow).
+    // Without the rule some pass for points at infinity (the others' BA depth went behind the camera in the
+    // first state solve, where the weight step's depth fit cannot follow, and eq. 10 rejects them).
     if (k == 0) CHECK(riders_kept > 0);
   }
 }
