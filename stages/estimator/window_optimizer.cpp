@@ -180,14 +180,13 @@ double feature_residual_with(const WindowFeature& f, const WindowSolveOptions& o
 /// Mono: did the track show no parallax where the window's typical point would have? With `g` filled by
 /// feature_residual_with() and K = `max_depth_baselines`: its best-fit depth is beyond K times the
 /// baseline b it was seen over (parallax under 1/K rad) while `median_depth`, that of the tracks in use,
-/// is within K b.
-/// Such a track carries no depth the window can observe, and a point moving with the camera (a truck
-/// leading it) looks exactly like one at infinity: its bearing keeps still while the camera drives.
-/// Used at eq. 10's weight ~1, the truck's tracks (half the image) pulled the attitude and with it the
-/// gravity the accelerometer subtracts, and the scale crept (README, "Street scenes"); the state step
-/// now leaves them out (ŵ = 0, and out of the prior). A far static point loses only rotation, which the
-/// gyroscope gives over a window. The median condition leaves the features alone where the whole
-/// window lacks parallax (at rest, or creeping): there a still track is no evidence of anything.
+/// is within K b. Such a track carries no depth the window can observe, and a point moving with the
+/// camera (a truck leading it) looks exactly like one at infinity: its bearing keeps still while the
+/// camera drives. Used at eq. 10's weight ~1, the truck's tracks (half the image) pulled the attitude and
+/// with it the gravity the accelerometer subtracts, and the scale crept (README, "Street scenes"); the
+/// state step now leaves them out (ŵ = 0, and out of the prior). A far static point loses only rotation,
+/// which the gyroscope gives over a window. The median condition leaves the features alone where the
+/// whole window lacks parallax (at rest, or creeping): there a still track is no evidence of anything.
 bool depth_unobservable(const FeatureGeometry& g, double max_depth_baselines, double median_depth) {
   const double reach = max_depth_baselines * g.baseline();  // K b [m]
   return max_depth_baselines > 0 && median_depth < reach && g.inverse_depth * reach < 1.0;
