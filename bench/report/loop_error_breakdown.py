@@ -32,7 +32,8 @@ def load_true_loops(loops_csv):
 
 
 def position_and_speed(gt, t):
-    """Ground-truth position [n,3] nearest to each time of t, and the speed there (central difference)."""
+    """Ground-truth position [n,3] at the sample at or just after each time of t, and the speed there
+    (central difference)."""
     i = np.clip(np.searchsorted(gt[:, 0], t), 1, len(gt) - 2)
     v = (gt[i + 1, 1:4] - gt[i - 1, 1:4]) / (gt[i + 1, 0] - gt[i - 1, 0])[:, None]
     return gt[i, 1:4], np.linalg.norm(v, axis=1)
