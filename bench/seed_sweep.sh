@@ -1,12 +1,12 @@
 #!/usr/bin/env bash
 # One draw is not a measurement (issue 23): an estimator change moves a single run's ATE by tens of
 # percent either way. This runs scenes at several noise seeds (same world, path and traffic; other IMU
-# and image noise and object textures) with huber and with dynavins under up to two settings, and prints
+# and image noise and object textures) with huber and with dynavins under up to three settings, and prints
 # each ATE and the mean over the seeds, so a change is judged by its mean, not by one draw.
-# Usage: bench/seed_sweep.sh --seeds 21,22,23 [--mono] [--a "--set k=v ..."] [--b "--set k=v ..."]
+# Usage: bench/seed_sweep.sh --seeds 21,22,23 [--mono] [--a "--set k=v ..."] [--b "..."] [--c "..."]
 #                            SCENARIO...
-#   --a / --b: dynavins run options of the two settings compared (default: --a "" i.e. the defaults,
-#              no --b). Scenes are cached as bench/cache/NAME-seedS (scripts/cached-sim.sh).
+#   --a / --b / --c: dynavins run options of up to three settings compared (default: --a "" i.e. the
+#              defaults, no --b or --c). Scenes are cached as bench/cache/NAME-seedS (scripts/cached-sim.sh).
 # Every run is `dynavins run --rate 0 --loop off` (lossless, deterministic). Writes runs to
 # bench/results/seed_sweep/ (not kept in git) and the table to stdout.
 # Example (the README's "Street scenes" table, seeds 22-24; bench/results/seed_sweep.md has the others):
@@ -16,13 +16,14 @@ set -euo pipefail
 cd "$(dirname "$0")/.."
 bin=$(readlink -f "${DYNAVINS:-build/bin/dynavins}")
 python=${PYTHON:-/usr/bin/python3}
-seeds=""; mono=(); a=""; b=""; have_b=0; scenes=()
+seeds=""; mono=(); a=""; b=""; c=""; have_b=0; have_c=0; scenes=()
 while [ $# -gt 0 ]; do
   case $1 in
     --seeds) seeds=$2; shift ;;
     --mono) mono=(--mono) ;;
     --a) a=$2; shift ;;
     --b) b=$2; have_b=1; shift ;;
+    --c) c=$2; have_c=1; shift ;;
     -h|--help) sed -n '2,14p' "$0"; exit 0 ;;
     -*) echo "seed_sweep: unknown option $1" >&2; exit 2 ;;
     *) scenes+=("$1") ;;
@@ -62,18 +63,21 @@ for sc in "${scenes[@]}"; do
     run_one "$dir" a --ba dynavins $a
     # shellcheck disable=SC2086
     [ "$have_b" = 1 ] && run_one "$dir" b --ba dynavins $b
+    # shellcheck disable=SC2086
+    [ "$have_c" = 1 ] && run_one "$dir" c --ba dynavins $c
     rows+=("$sc $s $out/$cache${mono:+-mono}")
   done
 done
 
 printf '%s\n' "${rows[@]}" | "$python" -c '
 import json, sys, collections
-a, b, have_b = sys.argv[1], sys.argv[2], sys.argv[3] == "1"
+a, b, have_b, c, have_c = sys.argv[1], sys.argv[2], sys.argv[3] == "1", sys.argv[4], sys.argv[5] == "1"
 def ate(p):
     s = json.load(open(p + "/summary.json"))
     return s["ate_se3_m"], s.get("resets", 0)
-cols = ["huber", "a"] + (["b"] if have_b else [])
-print("SE3 ATE [m], rate 0, loop off; a = dynavins %s; b = dynavins %s" % (a or "(defaults)", b if have_b else "(not run)"))
+cols = ["huber", "a"] + (["b"] if have_b else []) + (["c"] if have_c else [])
+print("SE3 ATE [m], rate 0, loop off; a = dynavins %s; b = dynavins %s%s" % (a or "(defaults)", b if have_b else "(not run)",
+                                                                  "; c = dynavins %s" % c if have_c else ""))
 print("| scene | seed | " + " | ".join(cols) + " |")
 print("|---|---|" + "---|" * len(cols))
 sums = collections.defaultdict(lambda: collections.defaultdict(list))
@@ -87,4 +91,4 @@ for line in sys.stdin:
     print("| %s | %s | %s |" % (sc, seed, " | ".join(cells)))
 for sc, d in sums.items():
     print("| %s | **mean** | %s |" % (sc, " | ".join("**%.3f**" % (sum(d[c]) / len(d[c])) for c in cols)))
-' "$a" "$b" "$have_b"
+' "$a" "$b" "$have_b" "$c" "$have_c"
