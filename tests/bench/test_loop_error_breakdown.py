@@ -13,15 +13,9 @@ import numpy as np
 ROOT = os.path.abspath(os.path.join(os.path.dirname(__file__), "..", ".."))
 sys.path.insert(0, os.path.join(ROOT, "bench", "report"))
 import loop_error_breakdown as leb  # noqa: E402
+from checks import check  # noqa: E402  (tests/bench/checks.py, beside this script)
 
 SPEED = 2.0  # m/s along +x, so two keyframes dt seconds apart are 2*dt metres apart
-
-
-def check(cond, what):
-    if not cond:
-        print("FAIL:", what)
-        sys.exit(1)
-    print("ok:", what)
 
 
 def write_scene(d, loops):

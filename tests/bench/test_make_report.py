@@ -8,6 +8,7 @@ import os
 import subprocess
 import sys
 import tempfile
+from checks import check  # tests/bench/checks.py, beside this script
 
 ROOT = os.path.abspath(os.path.join(os.path.dirname(__file__), "..", ".."))
 SCRIPT = os.path.join(ROOT, "bench", "report", "make_report.py")
@@ -111,13 +112,6 @@ def build_results(results):
     write(os.path.join(results, "meta.tsv"),
           "mode\tquick\ncommit\tabc123\ndirty\tclean\ndate\t2026-01-01T00:00:00Z\nnproc\t2\n"
           "cpu\tTest CPU\nram_gb\t8\nbench_command\tscripts/bench.sh --quick\n")
-
-
-def check(cond, what):
-    if not cond:
-        print("FAIL:", what)
-        sys.exit(1)
-    print("ok:", what)
 
 
 def main():

@@ -12,16 +12,10 @@ import numpy as np
 ROOT = os.path.abspath(os.path.join(os.path.dirname(__file__), "..", ".."))
 sys.path.insert(0, os.path.join(ROOT, "bench", "report"))
 import static_point_fit as spf  # noqa: E402
+from checks import check  # noqa: E402  (tests/bench/checks.py, beside this script)
 
 # Camera = body, looking along +z; pinhole without distortion (fx = fy = 400).
 CAM = [400.0, 400.0, 320.0, 240.0, 0.0, 0.0, 0.0, 0.0]
-
-
-def check(cond, what):
-    if not cond:
-        print("FAIL:", what)
-        sys.exit(1)
-    print("ok:", what)
 
 
 def cameras(n, speed):
