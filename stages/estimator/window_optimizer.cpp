@@ -188,8 +188,8 @@ double feature_residual_with(const WindowFeature& f, const WindowSolveOptions& o
 /// which the gyroscope gives over a window. The median condition leaves the features alone where the
 /// whole window lacks parallax (at rest, or creeping): there a still track is no evidence of anything.
 bool depth_unobservable(const FeatureGeometry& g, double max_depth_baselines, double median_depth) {
-  const double reach = max_depth_baselines * g.baseline();  // K b [m]
-  return max_depth_baselines > 0 && median_depth < reach && g.inverse_depth * reach < 1.0;
+  const double reach = max_depth_baselines * g.baseline();  // K b [m]; K = 0 reaches nothing: never true
+  return median_depth < reach && g.inverse_depth * reach < 1.0;
 }
 
 /// Median depth of the features the last state step used (ŵ >= 0.5; from their inverse depth in the anchor
@@ -354,7 +354,8 @@ class WeightStep {
     for (int k = 0; k <= newest_; ++k) cameras_[k] = {s_.camera(k, 0), s_.camera(k, 1)};
     auto camera = [this](int k, int c) -> const CameraPose& { return cameras_[k][c]; };
     int settled = 0;
-    const double depth_median = opt_.stereo ? 0.0 : median_kept_depth(features);
+    const bool judge_depth = !opt_.stereo && opt_.mono_max_depth_baselines > 0;  // depth_unobservable
+    const double depth_median = judge_depth ? median_kept_depth(features) : 0.0;
     for (WindowFeature* f : features) {
       const double r = feature_residual_with(*f, opt_, camera, geometry_);
       const double w = solve_feature_weight(r, f->weight_prev, f->times_solved, opt_.weights);
@@ -362,7 +363,7 @@ class WeightStep {
       f->weight = w;
       // eq. 10 keeps such a track (it fits a point at infinity); it only stays out of the state step.
       const bool unobservable =
-          !opt_.stereo && depth_unobservable(geometry_, opt_.mono_max_depth_baselines, depth_median);
+          judge_depth && depth_unobservable(geometry_, opt_.mono_max_depth_baselines, depth_median);
       f->state_weight = unobservable ? 0.0 : state_step_weight(w, opt_.weights);
     }
     st_.weight_ms += ms_since(t0);
