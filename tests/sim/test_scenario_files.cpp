@@ -133,3 +133,22 @@ TEST_CASE("`standstill_high`: the camera stands still while a truck covers most 
   CHECK(covered >= 20);  // >= 1 s at 20 Hz
   CHECK(*std::max_element(share.begin(), share.end()) > 0.8);
 }
+
+TEST_CASE("The street family: every traffic scene is its static twin's drive", "[scenario][files]") {
+  // r_d compares a scene with its twin: same world, path and noise seed, traffic only (README, "Street scenes").
+  const std::pair<const char*, const char*> pairs[] = {{"street_crowd", "street_none"},
+                                                       {"street_crowd_night", "street_none"},
+                                                       {"street_jam", "street_none"},
+                                                       {"street_follow", "street_follow_none"}};
+  for (const auto& [scene, twin_name] : pairs) {
+    INFO(scene);
+    const auto s = load_scenario((kScenarios / (std::string(scene) + ".yaml")).string());
+    const auto twin = load_scenario((kScenarios / (std::string(twin_name) + ".yaml")).string());
+    CHECK(twin.objects.empty());
+    CHECK_FALSE(s.objects.empty());
+    CHECK(s.waypoints == twin.waypoints);
+    CHECK(s.world_seed == twin.world_seed);
+    CHECK(s.seed == twin.seed);
+    CHECK(s.duration == twin.duration);
+  }
+}
