@@ -69,26 +69,4 @@ for sc in "${scenes[@]}"; do
   done
 done
 
-printf '%s\n' "${rows[@]}" | "$python" -c '
-import json, sys, collections
-a, b, have_b, c, have_c = sys.argv[1], sys.argv[2], sys.argv[3] == "1", sys.argv[4], sys.argv[5] == "1"
-def ate(p):
-    s = json.load(open(p + "/summary.json"))
-    return s["ate_se3_m"], s.get("resets", 0)
-cols = ["huber", "a"] + (["b"] if have_b else []) + (["c"] if have_c else [])
-print("SE3 ATE [m], rate 0, loop off; a = dynavins %s; b = dynavins %s%s" % (a or "(defaults)", b if have_b else "(not run)",
-                                                                  "; c = dynavins %s" % c if have_c else ""))
-print("| scene | seed | " + " | ".join(cols) + " |")
-print("|---|---|" + "---|" * len(cols))
-sums = collections.defaultdict(lambda: collections.defaultdict(list))
-for line in sys.stdin:
-    sc, seed, base = line.split()
-    cells = []
-    for c in cols:
-        v, r = ate(base + "-" + c)
-        sums[sc][c].append(v)
-        cells.append("%.3f%s" % (v, " (%d resets)" % r if r else ""))
-    print("| %s | %s | %s |" % (sc, seed, " | ".join(cells)))
-for sc, d in sums.items():
-    print("| %s | **mean** | %s |" % (sc, " | ".join("**%.3f**" % (sum(d[c]) / len(d[c])) for c in cols)))
-' "$a" "$b" "$have_b" "$c" "$have_c"
+printf '%s\n' "${rows[@]}" | "$python" bench/report/seed_sweep_table.py "$a" "$b" "$have_b" "$c" "$have_c"
