@@ -17,6 +17,8 @@ import argparse
 
 import numpy as np
 
+from make_report import path_length  # bench/report/, beside this script
+
 MIN_BIN_PATH_M = 0.5  # below this the ratio is mostly noise (the camera at rest)
 
 
@@ -34,10 +36,9 @@ def speed_ratios(estimate, groundtruth, bin_s=2.0):
         m = (te >= start) & (te < start + bin_s)
         if m.sum() < 3:
             continue
-        est = np.linalg.norm(np.diff(pe[m], axis=0), axis=1).sum()
-        true = np.linalg.norm(np.diff(pt[m], axis=0), axis=1).sum()
+        true = path_length(pt[m])
         if true >= MIN_BIN_PATH_M:
-            out.append((float(start - tg[0]), float(est / true)))
+            out.append((float(start - tg[0]), path_length(pe[m]) / true))
     return out
 
 
