@@ -3,6 +3,7 @@
 // answer on any machine), scored against the simulator's ground truth. Shared by the scene tests.
 #include <cstdint>
 #include <exception>
+#include <functional>
 #include <limits>
 #include <map>
 #include <memory>
@@ -22,10 +23,13 @@ struct SceneRun {
   double ate = 1e9;                        ///< ATE RMSE [m] (SE3) against the ground truth; NaN if undefined
 };
 
-inline SceneRun run_scene(const std::shared_ptr<const sim::Scenario>& sc, estimator::BaLoss loss, bool stereo = true) {
+/// `edit`, when given, changes the scenario's estimator options before the run (an A/B of one key).
+inline SceneRun run_scene(const std::shared_ptr<const sim::Scenario>& sc, estimator::BaLoss loss, bool stereo = true,
+                          const std::function<void(EstimatorOptions&)>& edit = {}) {
   sim::ScenarioSource src(sc);
   pipeline::VioRunOptions opt;
   opt.estimator = sim::scenario_estimator_options(*sc);
+  if (edit) edit(opt.estimator);
   opt.mode.loss = loss;
   opt.mode.stereo = stereo;
   opt.show_progress = false;

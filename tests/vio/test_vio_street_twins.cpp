@@ -113,3 +113,35 @@ TEST_CASE("mono initialises behind a truck that leads the camera", "[vio][dynami
   CHECK(truck_init <= twin_init + 1.0);
   CHECK(std::abs(truck_scale - 1.0) < 0.1);
 }
+
+TEST_CASE("mono initialises at night when its first windows have parallax but no scale",
+          "[vio][street][mono]") {
+  // bench/scenarios/street_crowd_night.yaml at noise seed 22, first 6 s: the car starts from rest at
+  // t = 1 s. The latest 11 frames (0.5 s) reach the parallax test only at 2.85 s, late in the
+  // acceleration, and their scale is too uncertain from then on (then the car cruises: no excitation);
+  // at full length this draw did not initialise until 47.95 s (issue 23). Every other frame of the last
+  // 21 (1 s, mono_init_wide_window) holds more of the acceleration. Measured when written: initialised at
+  // t = 2.85 s with it, never in these 6 s without; path length / true 1.050 (bound: 15 %).
+  const auto night = sim::build_scenario(
+      sim::load_scenario(std::string(DYNAVINS_SOURCE_DIR) + "/bench/scenarios/street_crowd_night.yaml"), 22, 6.0);
+  const Outcome narrow = test::run_scene(night, estimator::BaLoss::Dynavins, false,
+                                         [](EstimatorOptions& o) { o.mono_init_wide_window = false; });
+  const Outcome wide = test::run_scene(night, estimator::BaLoss::Dynavins, false);
+  REQUIRE_FALSE(wide.run.estimate.poses.empty());
+  const double t0 = 1e-9 * static_cast<double>(wide.true_speed.begin()->first);
+  const double init = 1e-9 * static_cast<double>(wide.run.estimate.poses.front().t_ns) - t0;
+  double est = 0.0, truth = 0.0;
+  const auto& p = wide.run.estimate.poses;
+  for (std::size_t i = 1; i < p.size(); ++i) {
+    est += (p[i].p - p[i - 1].p).norm();
+    const auto v = wide.true_speed.lower_bound(p[i].t_ns);
+    if (v != wide.true_speed.end()) truth += v->second * 1e-9 * static_cast<double>(p[i].t_ns - p[i - 1].t_ns);
+  }
+  INFO("initialised at t = " << init << " s; path length / true " << est / truth << "; without the wide window "
+                             << narrow.run.estimate.poses.size() << " frames estimated");
+  CHECK(wide.run.resets == 0);
+  CHECK(init < 3.5);
+  CHECK(std::abs(est / truth - 1.0) < 0.15);
+  // The draw still shows the failure this guards against (if the simulator changes, pick another draw).
+  CHECK(narrow.run.estimate.poses.empty());
+}

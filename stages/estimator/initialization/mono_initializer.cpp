@@ -32,6 +32,7 @@ MonoInitResult initialize_mono(const std::vector<InitWindowFrame>& window, const
     res.reason = sfm.reason;
     return res;
   }
+  res.sfm_succeeded = true;
   res.sfm_reference_frame = sfm.reference_frame;
   res.sfm_rms_reprojection_px = sfm.rms_reprojection_px;
   std::vector<Eigen::Matrix3d> R_c0_b(n);

@@ -39,6 +39,7 @@ struct FeatureDepth {
 struct MonoInitResult {
   bool success = false;
   std::string reason;                      ///< why it failed (empty on success)
+  bool sfm_succeeded = false;              ///< the SfM worked: a failure is the alignment's (scale, gravity)
   std::vector<Eigen::Matrix3d> R_wb;       ///< body-to-world rotation per frame
   std::vector<Eigen::Vector3d> p_wb;       ///< body position per frame [m]
   std::vector<Eigen::Vector3d> v_wb;       ///< body velocity in the world per frame [m/s]
