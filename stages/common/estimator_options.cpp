@@ -58,7 +58,7 @@ const std::vector<OptionSpec>& option_specs() {
       {"kept_full_weight", &O::kept_full_weight, {}, "", "1: kept features at full weight in the state step (ours, issue 23; off: mixed result, README); 0 = w_j^2 (eq. 11)"},
       {"residual_per_component", &O::residual_per_component, {}, "", "1: r_j per residual component, in units of the configured noise (ours, issue 23; off: mixed result, README); 0 = per observation"},
       {"mono_max_depth_baselines", &O::mono_max_depth_baselines, {0, 1000}, "", "mono: a track deeper than this many times its baseline, while the median depth of the tracks in use is within that, stays out of the state step (ours, issue 23); 0 = off"},
-      {"mono_init_wide_window", &O::mono_init_wide_window, {}, "", "mono: when the latest window_size + 1 frames have the parallax but not the scale, try every other frame of the last 2 window_size + 1 (ours, issue 23)"},
+      {"mono_init_wide_window", &O::mono_init_wide_window, {}, "", "mono: after window_size initialisation attempts in a row with the parallax but not the scale, try every other frame of the last 2 window_size + 1 (ours, issue 23)"},
       {"zupt", &O::zupt, {}, "", "zero-velocity update (ours, OpenVINS' keys)"},
       {"zupt_max_velocity", &O::zupt_max_velocity, {0, 10}, "m/s", "at rest only below this speed of the last solve"},
       {"zupt_max_disparity", &O::zupt_max_disparity, {0, 50}, "px", "at rest only below this median rotation-compensated motion"},

@@ -98,10 +98,10 @@ struct EstimatorOptions {
   /// moving with the camera looks exactly like it (window_optimizer.cpp, depth_unobservable; README,
   /// "Street scenes"). 30 = a parallax of 1.9 deg.
   double mono_max_depth_baselines = 30.0;
-  /// Ours (mono): when the latest window_size + 1 frames have the parallax but not the scale (the SfM
-  /// worked, the visual-inertial alignment did not), try every other frame of the last 2 window_size + 1
-  /// (twice the time, the same slots) before dropping the oldest: a start from rest reaches the parallax
-  /// late in its acceleration, and the scale then misses it (README, "Street scenes").
+  /// Ours (mono): when window_size attempts in a row had the parallax but not the scale (the SfM worked,
+  /// the visual-inertial alignment did not), try every other frame of the last 2 window_size + 1 (twice
+  /// the time, the same slots) before dropping the oldest: a start from rest can reach the parallax late
+  /// in its acceleration, and the scale then misses it for good (README, "Street scenes").
   bool mono_init_wide_window = true;
   /// Ours, not the paper's: zero-velocity update (standstill_detector.hpp), with OpenVINS' key names and
   /// defaults. A frame whose kept features show less than `zupt_max_disparity` px of rotation-compensated

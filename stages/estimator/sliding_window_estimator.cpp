@@ -120,6 +120,7 @@ struct SlidingWindowEstimator::Impl {
   std::vector<cv::Mat> slot_image;
   int64_t last_emitted_t_ns = INT64_MIN;  ///< newest keyframe handed out (each goes out once)
   InitFrameHistory init_history;  ///< mono, before tracking: the last 2W+1 frames (initialize_mono_wide)
+  int scale_failures = 0;         ///< consecutive mono attempts with the parallax but not the scale
 };
 
 void SlidingWindowEstimator::Impl::clear_window() {
@@ -136,6 +137,7 @@ void SlidingWindowEstimator::Impl::reset_all() {
   clear_window();
   optimizer.reset();
   init_history.clear();
+  scale_failures = 0;
   tracking = false;
 }
 
@@ -299,10 +301,11 @@ bool SlidingWindowEstimator::Impl::initialize_mono_window(std::string* why, bool
   return true;
 }
 
-/// After the latest W+1 frames had the parallax but not the scale (the alignment failed): every other frame
-/// of the last 2W+1, the same slots over twice the time, so more of the acceleration. Not tried while the
-/// parallax is short: there it would start earlier than the W+1 frames do, on a worse scale (measured:
-/// street_none mono 0.193 m against 0.161 over 8 noise draws; README, "Street scenes"). Tried on copies;
+/// A last resort, after W windows in a row (a window's length) had the parallax but not the scale (the
+/// alignment failed): every other frame of the last 2W+1, the same slots over twice the time, so more of
+/// the acceleration. Tried while the parallax was short, it started every street earlier on a worse
+/// scale; tried after any scale failure, it changed runs the W+1 frames start a few frames later, for the
+/// worse as often as for the better (README, "Street scenes"). Tried on copies;
 /// only on success is the window rebuilt from those frames, so a failure leaves the consecutive window
 /// exactly as it was. Its failures are logged at debug only (the consecutive window's reason at info).
 bool SlidingWindowEstimator::Impl::initialize_mono_wide(bool* keep_second_newest) {
@@ -336,8 +339,9 @@ bool SlidingWindowEstimator::Impl::initialize_mono_wide(bool* keep_second_newest
     }
     *keep_second_newest = features.add_frame(newest, h.frame, opt.keyframe_parallax / kNominalFocalPx, false);
   }
-  spdlog::info("mono initialisation on every other frame of the last {} ({:.2f} s), after the latest {} failed",
-               init_history.size(), (frames.back().frame.t_ns - frames.front().frame.t_ns) * 1e-9, W + 1);
+  spdlog::info("mono initialisation on every other frame of the last {} ({:.2f} s): the latest {} had the "
+               "parallax but not the scale {} times in a row",
+               init_history.size(), (frames.back().frame.t_ns - frames.front().frame.t_ns) * 1e-9, W + 1, W);
   apply_mono_init(r);
   return true;
 }
@@ -532,7 +536,8 @@ WindowEstimate SlidingWindowEstimator::Impl::process(const TrackedFrame& frame, 
     std::string why;
     bool sfm_succeeded = false;
     bool ok = mode.stereo ? initialize_stereo(&why) : initialize_mono_window(&why, &sfm_succeeded);
-    if (!ok && sfm_succeeded && init_history.full()) ok = initialize_mono_wide(&keep_second_newest);
+    scale_failures = !ok && sfm_succeeded ? scale_failures + 1 : 0;
+    if (scale_failures >= W && init_history.full()) ok = initialize_mono_wide(&keep_second_newest);
     if (!ok) {
       // Each new reason once at info (a standing camera would otherwise say the same every frame).
       if (why != last_init_failure) spdlog::info("not initialised yet at t={:.3f} s: {}", frame.t_ns * 1e-9, why);

@@ -119,9 +119,10 @@ TEST_CASE("mono initialises at night when its first windows have parallax but no
   // bench/scenarios/street_crowd_night.yaml at noise seed 22, first 6 s: the car starts from rest at
   // t = 1 s. The latest 11 frames (0.5 s) reach the parallax test only at 2.85 s, late in the
   // acceleration, and their scale is too uncertain from then on (then the car cruises: no excitation);
-  // at full length this draw did not initialise until 47.95 s (issue 23). Every other frame of the last
-  // 21 (1 s, mono_init_wide_window) holds more of the acceleration. Measured when written: initialised at
-  // t = 2.85 s with it, never in these 6 s without; path length / true 1.050 (bound: 15 %).
+  // at full length this draw did not initialise until 47.95 s (issue 23). After 10 such windows in a
+  // row, every other frame of the last 21 (1 s, mono_init_wide_window) holds more of the acceleration.
+  // Measured when written: initialised at t = 3.3 s with it (the first such try; bound 4 s), never in
+  // these 6 s without; path length / true 0.979 (bound: 15 %).
   const auto night = sim::build_scenario(
       sim::load_scenario(std::string(DYNAVINS_SOURCE_DIR) + "/bench/scenarios/street_crowd_night.yaml"), 22, 6.0);
   const Outcome narrow = test::run_scene(night, estimator::BaLoss::Dynavins, false,
@@ -140,7 +141,7 @@ TEST_CASE("mono initialises at night when its first windows have parallax but no
   INFO("initialised at t = " << init << " s; path length / true " << est / truth << "; without the wide window "
                              << narrow.run.estimate.poses.size() << " frames estimated");
   CHECK(wide.run.resets == 0);
-  CHECK(init < 3.5);
+  CHECK(init < 4.0);
   CHECK(std::abs(est / truth - 1.0) < 0.15);
   // The draw still shows the failure this guards against (if the simulator changes, pick another draw).
   CHECK(narrow.run.estimate.poses.empty());
