@@ -305,9 +305,9 @@ bool SlidingWindowEstimator::Impl::initialize_mono_window(std::string* why, bool
 /// alignment failed): every other frame of the last 2W+1, the same slots over twice the time, so more of
 /// the acceleration. Tried while the parallax was short, it started every street earlier on a worse
 /// scale; tried after any scale failure, it changed runs the W+1 frames start a few frames later, for the
-/// worse as often as for the better (README, "Street scenes"). Tried on copies;
-/// only on success is the window rebuilt from those frames, so a failure leaves the consecutive window
-/// exactly as it was. Its failures are logged at debug only (the consecutive window's reason at info).
+/// worse as often as for the better (README, "Street scenes"). Tried on copies; only on success is the
+/// window rebuilt from those frames, so a failure leaves the consecutive window exactly as it was. Its
+/// failures are logged at debug only (the consecutive window's reason at info).
 bool SlidingWindowEstimator::Impl::initialize_mono_wide(bool* keep_second_newest) {
   const std::vector<HistoryFrame> frames = init_history.strided(2);
   std::vector<InitWindowFrame> window(frames.size());
