@@ -8,7 +8,7 @@
 #   loop-only:                only the loop-closure scenes, DynaVINS BA, their loop-mode runs, mono on
 #                             revisit only, no --loop off run (12 runs) -> bench/results/loop/
 # Loop scenes (loop_scenes below) also run with --loop all and --loop switchable (DynaVINS BA; stereo
-# and mono, temporal_static stereo only, to keep the bench's time), beside the plain runs, which are
+# and mono), beside the plain runs, which are
 # --loop dynavins and whose odometry.tum is --loop off's; and one --loop off run (e_shape stereo) for
 # the estimator's speed without the loop thread.
 # Every run: `dynavins run --rate 0` (lossless replay; at rate 0 the solves are bounded by iterations
@@ -95,7 +95,7 @@ runs_per_scene=$((2 * ${#bas[@]}))
 loop_sensors=(stereo mono)
 # --loop-only keeps to the runs the loop table needs most: mono (odometry that drifts) on revisit only
 loop_sensors_of() {
-  if [ "$1" = temporal_static ] || { [ "$quick" = 2 ] && [ "$1" != revisit ]; }; then echo stereo; else echo "${loop_sensors[@]}"; fi
+  if [ "$quick" = 2 ] && [ "$1" != revisit ]; then echo stereo; else echo "${loop_sensors[@]}"; fi
 }
 is_loop_scene() { local s; for s in "${loop_scenes[@]}"; do [ "$s" = "$1" ] && return 0; done; return 1; }
 n_loop=0
