@@ -146,7 +146,7 @@ def feature_scores(features_csv):
     fp = sum(w < 0.5 for w in static)
     return {
         "moving": len(moving), "static": len(static), "tp": tp, "fp": fp,
-        "precision": tp / (tp + fp) if tp + fp else float("nan"),
+        "precision": tp / (tp + fp) if moving and tp + fp else float("nan"),  # nothing moves: no precision
         "recall": tp / len(moving) if moving else float("nan"),
         "static_kept": sum(w > 0.5 for w in static) / len(static) if static else float("nan"),
     }
@@ -387,7 +387,8 @@ def table_ablation(runs):
 
 
 def feature_rows(runs, scenarios):
-    """Per scenario with moving objects and per mode: the DynaVINS run's rejection scores."""
+    """Per scenario and mode: the DynaVINS run's rejection scores (on a scene where nothing moves only
+    the static columns mean anything: issue 23's static twins)."""
     rows = []
     for s in scenarios:
         for mode, tag in MODES:
@@ -398,8 +399,6 @@ def feature_rows(runs, scenarios):
                     rows.append((s, tag, None, r.status))
                 continue
             sc = feature_scores(path)
-            if sc["moving"] == 0:
-                continue  # nothing moves in this scene
             sc.update(scores_against_true_poses(r, path))
             rows.append((s, tag, sc, r.status))
     return rows
@@ -865,7 +864,9 @@ def write_report(results_dir, meta, manifest, runs, figures):
           "DynaVINS runs, each feature's final weight (its last row in `features.csv`), features solved at "
           "least once. Rejected: weight < 0.5. Moving: `sim_label > 0`; static: `sim_label == 0`. "
           "Precision = rejected moving / all rejected; recall = rejected moving / all moving; "
-          "static kept = static with weight > 0.5 / all static. Scenes without moving features are left out. "
+          "static kept = static with weight > 0.5 / all static. Scenes where nothing moves (the static twins) have "
+          "only the static columns: issue 23 asks for fewer than 5 % of their static features below weight "
+          "0.5, i.e. static kept above 0.95. "
           "Moving, separable: the moving features that no static point explains under the true poses "
           f"(best static point fitted to the feature's whole track with the ground-truth poses: its left "
           f"pixels, and in stereo runs its right pixels too; its r_j above λw = {LAMBDA_W:g}; see "

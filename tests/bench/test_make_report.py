@@ -62,12 +62,18 @@ FEATURES = "\n".join([
     "2,2,5,0,0,0.1,0,0,0,0,0",
     "2,2,6,0,0,0.1,3,-1,0,0,0",
 ]) + "\n"
+# a scene where nothing moves (a static twin): three static features solved, one of them rejected
+STATIC_FEATURES = "\n".join([
+    "1,1,1,0,0,0.9,1,0,0,0,0",
+    "1,1,2,0,0,0.2,1,0,0,0,0",
+    "1,1,3,0,0,0.95,2,0,0,0,0",
+]) + "\n"
 
 
 def build_results(results):
     runs = [  # scenario, mode, ba, status, summary, features
         ("none", "stereo", "huber", "ok", summary(0.5), None),
-        ("none", "stereo", "dynavins", "ok", summary(0.4), None),
+        ("none", "stereo", "dynavins", "ok", summary(0.4), STATIC_FEATURES),
         ("high", "stereo", "huber", "exit1", None, None),                      # run error
         ("high", "stereo", "dynavins", "ok", summary(0.45, resets=2), FEATURES),
         ("none", "mono", "huber", "ok", summary(0.6), None),
@@ -134,6 +140,8 @@ def main():
         check("✗ lost (10% tracked)" in report, "the lost run is shown as lost")
         check("(2 resets)" in report, "resets are marked")
         check("| 0.500 | 0.500 | 0.500 |" in report, "precision / recall / static kept in the report")
+        check("| `none` | `S-I` | 0 | 3 | — | — | 0.667 |" in report,
+              "a scene where nothing moves has its static kept (no precision or recall)")
         check("0.300 → 0.400 (**1.33**)" in report, "degradation over seeds: mean ATEs (0.4, 0.2 / 0.45, 0.35) and ratio")
         check("| DynaVINS-`M-I` | 0.500 → 0.550 (1.10) | not run → not run (✗) | ✗ |" in report,
               "a mode with a missing seed run gets no mean (not averaged away)")
