@@ -28,6 +28,7 @@ const std::vector<OptionSpec>& option_specs() {
       {"show_track", &O::show_track, {}, "", "VINS-Fusion's tracking image (read, not drawn here)"},
       {"flow_back", &O::flow_back, {}, "", "forward-backward check of the temporal KLT"},
       {"patch_refine", &O::patch_refine, {}, "", "align each track's first patch after the KLT (ours); 0 = plain KLT"},
+      {"equalize", &O::equalize, {}, "", "VINS-Mono: CLAHE on every image before tracking (dark scenes)"},
       // Optimization.
       {"max_solver_time", &O::max_solver_time, {0, 3600, true}, "s", "Ceres time budget per window solve"},
       {"max_num_iterations", &O::max_num_iterations, {1, 1000}, "", "Ceres iterations per window solve"},
@@ -87,7 +88,7 @@ const std::vector<std::string>& known_unused_keys() {
       "pose_graph_save_path", "save_image", "use_gpu", "use_gpu_acc_flow", "use_gpu_ceres",
       // VINS-Mono configs.
       "image_topic", "model_type", "camera_name", "distortion_parameters", "projection_parameters",
-      "extrinsicRotation", "extrinsicTranslation", "ex_calib_result_path", "equalize", "fisheye", "fisheye_mask",
+      "extrinsicRotation", "extrinsicTranslation", "ex_calib_result_path", "fisheye", "fisheye_mask",
       "loop_closure", "fast_relocalization", "rolling_shutter", "rolling_shutter_tr", "visualize_imu_forward",
       "visualize_camera_size",
       // The authors' DynaVINS configs (visualisation, test switch and their loop closure).

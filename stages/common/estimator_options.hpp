@@ -52,6 +52,8 @@ struct EstimatorOptions {
   /// Ours, not VINS-Fusion's: align each track's first patch after the KLT (tracker_options.hpp); 0 gives
   /// VINS-Fusion's plain frame-to-frame KLT.
   bool patch_refine = true;
+  /// VINS-Mono's key: contrast-limited histogram equalisation (CLAHE) of every image before tracking.
+  bool equalize = false;
 
   // Optimization.
   double max_solver_time = 0.04;  ///< seconds

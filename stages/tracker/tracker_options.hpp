@@ -43,6 +43,7 @@ struct TrackerOptions {
     t.min_dist = o.min_dist;
     t.flow_back = o.flow_back;
     t.patch_refine = o.patch_refine;
+    t.clahe = o.equalize;
     t.f_threshold = o.F_threshold;
     return t;
   }

@@ -24,6 +24,7 @@
 #include "stages/common/config_error.hpp"
 #include "stages/common/config_reader.hpp"
 #include "stages/common/estimator_options.hpp"
+#include "stages/tracker/tracker_options.hpp"
 #include "tests/log_capture.hpp"
 
 using namespace dynavins;
@@ -163,6 +164,17 @@ TEST_CASE("regularization_lambda is the authors' gamma: lambda_w = gamma^2", "[o
   const auto absent = EstimatorOptions::load(s.edit("calibration_stereo.yaml", "regularization_lambda:  2.0\n", ""));
   CHECK(absent.regularization_gamma == 1.0);
   CHECK(absent.lambda_w == 1.0);  // the paper's default
+}
+
+TEST_CASE("VINS-Mono's equalize key turns on the tracker's CLAHE", "[options]") {
+  ScratchConfig s(kViode);
+  const auto absent = EstimatorOptions::load(kViode + "calibration_stereo.yaml");
+  CHECK_FALSE(absent.equalize);
+  CHECK_FALSE(tracker::TrackerOptions::from(absent).clahe);
+  const auto on = EstimatorOptions::load(
+      s.edit("calibration_stereo.yaml", "regularization_lambda:  2.0\n", "regularization_lambda:  2.0\nequalize: 1\n"));
+  CHECK(on.equalize);
+  CHECK(tracker::TrackerOptions::from(on).clahe);
 }
 
 TEST_CASE("print() lists every effective option with its source", "[options]") {
