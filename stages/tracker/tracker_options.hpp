@@ -14,7 +14,7 @@ struct TrackerOptions {
   double max_back_error = 0.5;
   bool f_ransac = false;     ///< fundamental-matrix RANSAC on temporal tracks (VINS-Fusion: off)
   double f_threshold = 1.0;  ///< [px] RANSAC threshold on a virtual 460 px focal length
-  bool clahe = false;        ///< contrast-limited equalization before tracking (dark scenes)
+  bool clahe = false;        ///< contrast-limited equalization before tracking (dark scenes; key equalize)
   double clahe_clip = 3.0;
   bool stereo_gain_match = true;  ///< scale the right image to the left's mean before stereo KLT
   /// A track without a right match searches again only every this many frames (1: every frame). On
@@ -36,7 +36,7 @@ struct TrackerOptions {
   double quality_level = 0.01;  ///< corner threshold, relative to the strongest unmasked corner
   int border = 1;               ///< [px] features this close to the edge are dropped
 
-  /// The tracker keys of a loaded VINS-Fusion / DynaVINS config (the rest keep the defaults).
+  /// The tracker keys of a loaded VINS-Fusion / DynaVINS / VINS-Mono config (the rest keep the defaults).
   static TrackerOptions from(const EstimatorOptions& o) {
     TrackerOptions t;
     t.max_cnt = o.max_cnt;
