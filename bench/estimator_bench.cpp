@@ -76,14 +76,29 @@ int main(int argc, char** argv) {
   std::optional<double> duration;
   bool mono = false;
   std::string out_dir;
+  std::vector<std::string> sets;
   app.add_option("--scenario", scenario, "Name in bench/scenarios or a file")->capture_default_str();
   app.add_option("--duration", duration, "Seconds to simulate (default: the scenario's)");
   app.add_option("--ba", modes, "Comma-separated BA losses")->capture_default_str();
   app.add_flag("--mono", mono, "Mono-inertial (cam0 only)");
   app.add_option("--log-level", level)->capture_default_str();
   app.add_option("--out", out_dir, "Write <ba>.tum and groundtruth.tum here");
+  app.add_option("--set", sets, "Override an estimator / tracker option: --set key=value (repeatable)");
   CLI11_PARSE(app, argc, argv);
   spdlog::set_level(spdlog::level::from_str(level));
+
+  // Checked before the scenario is built (seconds), on the defaults: the same keys and ranges.
+  std::vector<std::pair<std::string, std::string>> overrides;
+  try {
+    EstimatorOptions check;
+    for (const std::string& s : sets) {
+      overrides.push_back(EstimatorOptions::parse_override(s));
+      check.apply(overrides.back().first, overrides.back().second);
+    }
+  } catch (const std::exception& e) {
+    spdlog::error("{}", e.what());
+    return 2;
+  }
 
   std::string path = scenario;
   if (!std::filesystem::is_regular_file(path)) path = std::string(DYNAVINS_SOURCE_DIR) + "/bench/scenarios/" + scenario + ".yaml";
@@ -91,6 +106,7 @@ int main(int argc, char** argv) {
   // Rate 0: iteration-bound solves (max_num_iterations only), so the answer does not depend on machine load.
   pipeline::VioRunOptions opt;
   opt.estimator = sim::scenario_estimator_options(*sc);
+  for (const auto& [key, value] : overrides) opt.estimator.apply(key, value);
   opt.show_progress = false;
 
   std::stringstream ss(modes);
