@@ -475,7 +475,8 @@ TEST_CASE("tracker::StereoTracker: CLAHE recovers features in a dark low-contras
   };
   const int off = correctly_tracked(false), on = correctly_tracked(true);
   std::printf("dark image: %d tracks correct without CLAHE, %d with\n", off, on);
-  // Measured when written (deterministic seeds): 78 without, 103 with (tracks within 1 px of the true shift).
+  // Measured (deterministic seeds): 76 without, 96 with (tracks within 1 px of the true shift; 78 / 103 when
+  // written, before later tracker changes).
   CHECK(on >= 1.2 * off);
   CHECK(on >= 80);
 }
