@@ -9,6 +9,7 @@
 #include <CLI/CLI.hpp>
 #include <spdlog/spdlog.h>
 
+#include "bench/true_depth.hpp"
 #include "eval/evaluation.hpp"
 #include "eval/trajectory_io.hpp"
 #include "pipeline/vio/estimate_recorder.hpp"
@@ -36,16 +37,10 @@ class TrackTruth {
       if (tf.sim_label != 0) continue;
       auto it = points_.find(tf.id);
       if (it == points_.end()) {
-        // Bilinear true depth under the sub-pixel corner; corners on a depth edge are left unscored.
-        const int c = static_cast<int>(std::floor(tf.px.x())), r = static_cast<int>(std::floor(tf.px.y()));
-        if (r < 1 || c < 1 || r + 2 >= depth.rows || c + 2 >= depth.cols) continue;
-        float lo = 1e9f, hi = 0.f;
-        for (int dr = -1; dr <= 2; ++dr)
-          for (int dc = -1; dc <= 2; ++dc) lo = std::min(lo, depth.at<float>(r + dr, c + dc)), hi = std::max(hi, depth.at<float>(r + dr, c + dc));
-        if (!(lo > 0) || hi > 1.05f * lo || hi > 1e3f) continue;
-        const double a = tf.px.x() - c, b = tf.px.y() - r;
-        const double z = (1 - a) * (1 - b) * depth.at<float>(r, c) + a * (1 - b) * depth.at<float>(r, c + 1) +
-                         (1 - a) * b * depth.at<float>(r + 1, c) + a * b * depth.at<float>(r + 1, c + 1);
+        // True depth under the sub-pixel corner; corners on a depth edge are left unscored.
+        const std::optional<double> depth_m = bench::true_depth(depth, tf.px);
+        if (!depth_m) continue;
+        const double z = *depth_m;
         points_[tf.id] = T_wc * Eigen::Vector3d(tf.xy.x() * z, tf.xy.y() * z, z);
         max_err_[tf.id] = 0;
         continue;

@@ -1,0 +1,162 @@
+// bench_track_accuracy: how close the tracker's pixels are to the truth, on one simulated scenario,
+// tracker alone (deterministic, seconds). Three numbers a tracker change should be judged by before
+// any ATE, which one noise draw moves by up to 4x at night (README, "Street scenes"):
+//   - track error by track length: each static track's point is fixed at its first observation (true
+//     depth under the pixel) and projected with the true pose into every later frame;
+//   - fit: the best 3-D point of each static track (5+ observations, true poses) and its residuals,
+//     i.e. how well a track's observations agree with each other, whatever its first pixel;
+//   - stereo: each right observation against the true point under the same frame's left pixel.
+// The gyro's rotation prediction is the true rotation (the pipeline uses the gyro's).
+//   bench_track_accuracy --scenario street_crowd_night --seed 25 --duration 12 [--mono] [--set k=v]
+#include <algorithm>
+#include <cstdio>
+#include <filesystem>
+#include <map>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include <CLI/CLI.hpp>
+#include <spdlog/spdlog.h>
+
+#include "bench/true_depth.hpp"
+#include "sim/scenario/scenario.hpp"
+#include "sim/scenario/scenario_config.hpp"
+#include "sim/scenario/scenario_spec.hpp"
+#include "stages/tracker/stereo_tracker.hpp"
+
+using namespace dynavins;
+
+namespace {
+
+constexpr double kFocal = 460.0;  // errors in pixels of VINS' virtual camera, as everywhere in the benches
+
+struct Observation {
+  Eigen::Isometry3d T_wc;
+  Eigen::Vector2d xy;
+};
+
+void print_stats(const char* name, std::vector<double> v) {
+  if (v.empty()) {
+    std::printf("%-22s n      0\n", name);
+    return;
+  }
+  std::sort(v.begin(), v.end());
+  auto at = [&](double q) { return v[std::min(v.size() - 1, static_cast<std::size_t>(q * static_cast<double>(v.size())))]; };
+  std::printf("%-22s n %6zu  p50 %.3f  p90 %.3f px\n", name, v.size(), at(0.5), at(0.9));
+}
+
+/// Residuals [px] of the least-squares point of the rays (sum of squared distances to each ray).
+void fit_residuals(const std::vector<Observation>& obs, std::vector<double>* out) {
+  Eigen::Matrix3d A = Eigen::Matrix3d::Zero();
+  Eigen::Vector3d b = Eigen::Vector3d::Zero();
+  for (const Observation& o : obs) {
+    const Eigen::Vector3d d = (o.T_wc.linear() * o.xy.homogeneous()).normalized();
+    const Eigen::Matrix3d P = Eigen::Matrix3d::Identity() - d * d.transpose();
+    A += P;
+    b += P * o.T_wc.translation();
+  }
+  const Eigen::Vector3d X = A.ldlt().solve(b);
+  for (const Observation& o : obs) {
+    const Eigen::Vector3d p = o.T_wc.inverse() * X;
+    if (p.z() > 0) out->push_back(kFocal * (p.head<2>() / p.z() - o.xy).norm());
+  }
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  CLI::App app{"Tracker accuracy against the simulator's truth on one scenario (static features only)"};
+  std::string scenario = "street_crowd_night";
+  std::optional<uint64_t> seed;
+  std::optional<double> duration;
+  bool mono = false;
+  std::vector<std::string> sets;
+  app.add_option("--scenario", scenario, "Name in bench/scenarios or a file")->capture_default_str();
+  app.add_option("--seed", seed, "Noise seed (default: the scenario's)");
+  app.add_option("--duration", duration, "Seconds to simulate (default: the scenario's)");
+  app.add_flag("--mono", mono, "Left image only");
+  app.add_option("--set", sets, "Override a tracker option by its config key: --set key=value (repeatable)");
+  CLI11_PARSE(app, argc, argv);
+
+  std::string path = scenario;
+  if (!std::filesystem::is_regular_file(path)) path = std::string(DYNAVINS_SOURCE_DIR) + "/bench/scenarios/" + scenario + ".yaml";
+  std::shared_ptr<const sim::Scenario> sc;
+  tracker::TrackerOptions options;
+  EstimatorOptions est;
+  try {
+    sc = sim::build_scenario(sim::load_scenario(path), seed, duration);
+    est = sim::scenario_estimator_options(*sc);
+    for (const std::string& s : sets) {
+      const auto [key, value] = EstimatorOptions::parse_override(s);
+      est.apply(key, value);
+    }
+    options = tracker::TrackerOptions::from(est);
+  } catch (const std::exception& e) {
+    spdlog::error("{}", e.what());
+    return 2;
+  }
+  tracker::StereoTracker tracker(options, est.cameras.at(0), mono ? nullptr : est.cameras.at(1));
+  sim::ScenarioSource src(sc);
+
+  const int kBins = 5;
+  const int edges[kBins + 1] = {2, 3, 5, 9, 17, 1 << 30};
+  std::vector<double> by_length[kBins], stereo;
+  std::map<int64_t, Eigen::Vector3d> points;        // static tracks' true points (first observation)
+  std::map<int64_t, std::vector<Observation>> seen;  // every static observation, for the fit
+  std::optional<Eigen::Isometry3d> prev_T_wc;
+  SensorEvent e;
+  while (src.next(e)) {
+    auto* f = std::get_if<StereoFrame>(&e);
+    if (!f) continue;
+    StereoFrame frame = *f;
+    if (mono) frame.right = cv::Mat();
+    const double t = static_cast<double>(f->t_ns - sc->epoch_ns) * 1e-9;
+    Eigen::Isometry3d T_wb = Eigen::Isometry3d::Identity();
+    T_wb.linear() = sc->body->rotation(t);
+    T_wb.translation() = sc->body->position(t);
+    const Eigen::Isometry3d T_wc = T_wb * sc->rig.T_body_cam0, T_wc1 = T_wb * sc->rig.T_body_cam1;
+    std::optional<Eigen::Matrix3d> R_prev_curr;
+    if (prev_T_wc) R_prev_curr = prev_T_wc->linear().transpose() * T_wc.linear();
+    prev_T_wc = T_wc;
+    const TrackedFrame out = tracker.process(frame, R_prev_curr);
+    const cv::Mat& depth = src.last_left().depth;
+    for (const TrackedFeature& tf : out.features) {
+      if (tf.sim_label != 0) continue;
+      seen[tf.id].push_back({T_wc, tf.xy});
+      const std::optional<double> z = bench::true_depth(depth, tf.px);
+      const auto point = [&] { return T_wc * (*z * tf.xy.homogeneous()); };
+      if (tf.has_right && z) {
+        const Eigen::Vector3d p1 = T_wc1.inverse() * point();
+        stereo.push_back(kFocal * (p1.head<2>() / p1.z() - tf.xy_right).norm());
+      }
+      auto it = points.find(tf.id);
+      if (it == points.end()) {
+        if (tf.track_length == 1 && z) points.emplace(tf.id, point());
+        continue;
+      }
+      const Eigen::Vector3d p = T_wc.inverse() * it->second;
+      if (p.z() <= 0) continue;
+      for (int k = 0; k < kBins; ++k)
+        if (tf.track_length >= edges[k] && tf.track_length < edges[k + 1])
+          by_length[k].push_back(kFocal * (p.head<2>() / p.z() - tf.xy).norm());
+    }
+  }
+
+  std::printf("%s, seed %s, %s: static features, error against the truth\n", scenario.c_str(),
+              seed ? std::to_string(*seed).c_str() : "default", mono ? "mono" : "stereo");
+  std::vector<double> all;
+  for (int k = 0; k < kBins; ++k) {
+    all.insert(all.end(), by_length[k].begin(), by_length[k].end());
+    const std::string name = k + 1 < kBins ? "track length " + std::to_string(edges[k]) + "-" + std::to_string(edges[k + 1] - 1)
+                                           : "track length " + std::to_string(edges[k]) + "+";
+    print_stats(name.c_str(), by_length[k]);
+  }
+  print_stats("track, all lengths", all);
+  std::vector<double> fit;
+  for (const auto& [id, obs] : seen)
+    if (obs.size() >= 5) fit_residuals(obs, &fit);
+  print_stats("fit (5+ observations)", fit);
+  if (!mono) print_stats("stereo", stereo);
+  return 0;
+}
