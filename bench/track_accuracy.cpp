@@ -12,6 +12,7 @@
 #include <cstdio>
 #include <filesystem>
 #include <map>
+#include <numeric>
 #include <optional>
 #include <string>
 #include <vector>
@@ -105,6 +106,7 @@ int main(int argc, char** argv) {
   std::map<int64_t, Eigen::Vector3d> points;        // static tracks' true points (first observation)
   std::map<int64_t, std::vector<Observation>> seen;  // every static observation, for the fit
   std::optional<Eigen::Isometry3d> prev_T_wc;
+  long frames = 0, features = 0, with_right = 0;
   SensorEvent e;
   while (src.next(e)) {
     auto* f = std::get_if<StereoFrame>(&e);
@@ -121,6 +123,9 @@ int main(int argc, char** argv) {
     prev_T_wc = T_wc;
     const TrackedFrame out = tracker.process(frame, R_prev_curr);
     const cv::Mat& depth = src.last_left().depth;
+    ++frames;
+    features += static_cast<long>(out.features.size());
+    with_right += out.stats.stereo;
     for (const TrackedFeature& tf : out.features) {
       if (tf.sim_label != 0) continue;
       seen[tf.id].push_back({T_wc, tf.xy});
@@ -153,6 +158,16 @@ int main(int argc, char** argv) {
     print_stats(name.c_str(), by_length[k]);
   }
   print_stats("track, all lengths", all);
+  // How long static tracks live (a track that ends early is replaced by a fresh corner).
+  std::vector<double> lengths;
+  for (const auto& [id, obs] : seen) lengths.push_back(static_cast<double>(obs.size()));
+  std::sort(lengths.begin(), lengths.end());
+  const double mean_length =
+      lengths.empty() ? 0.0 : std::accumulate(lengths.begin(), lengths.end(), 0.0) / static_cast<double>(lengths.size());
+  std::printf("static tracks          n %6zu  mean length %.1f, median %.0f frames; %.1f features per frame, %.0f %% with a right match\n",
+              lengths.size(), mean_length, lengths.empty() ? 0.0 : lengths[lengths.size() / 2],
+              static_cast<double>(features) / static_cast<double>(std::max(1L, frames)),
+              100.0 * static_cast<double>(with_right) / static_cast<double>(std::max(1L, features)));
   std::vector<double> fit;
   for (const auto& [id, obs] : seen)
     if (obs.size() >= 5) fit_residuals(obs, &fit);
