@@ -86,7 +86,9 @@ int main(int argc, char** argv) {
   tracker::TrackerOptions options;
   EstimatorOptions est;
   try {
-    sc = sim::build_scenario(sim::load_scenario(path), seed, duration);
+    const sim::ScenarioSpec spec = sim::load_scenario(path);
+    if (!seed) seed = spec.seed;
+    sc = sim::build_scenario(spec, seed, duration);
     est = sim::scenario_estimator_options(*sc);
     for (const std::string& s : sets) {
       const auto [key, value] = EstimatorOptions::parse_override(s);
@@ -148,8 +150,8 @@ int main(int argc, char** argv) {
     }
   }
 
-  std::printf("%s, seed %s, %s: static features, error against the truth\n", scenario.c_str(),
-              seed ? std::to_string(*seed).c_str() : "default", mono ? "mono" : "stereo");
+  std::printf("%s, seed %llu, %s: static features, error against the truth\n", scenario.c_str(),
+              static_cast<unsigned long long>(*seed), mono ? "mono" : "stereo");
   std::vector<double> all;
   for (int k = 0; k < kBins; ++k) {
     all.insert(all.end(), by_length[k].begin(), by_length[k].end());

@@ -16,7 +16,8 @@
 # (manifest + report) and the bench goes on; it exits 1 at the end when a scene or run crashed.
 # Only the full bench rewrites the README headline.
 # DYNAVINS=path/to/dynavins (default build/bin/dynavins); BENCH_TRACKER=path/to/bench_tracker
-# (default build/bin/bench_tracker; skipped when missing); PYTHON (default /usr/bin/python3).
+# (default build/bin/bench_tracker; skipped when missing; bench_track_accuracy is taken from beside it);
+# PYTHON (default /usr/bin/python3).
 set -euo pipefail
 cd "$(dirname "$0")/.."
 
@@ -35,6 +36,8 @@ done
 
 bin=${DYNAVINS:-build/bin/dynavins}
 tracker_bin=${BENCH_TRACKER:-build/bin/bench_tracker}
+accuracy_bin=$(dirname "$tracker_bin")/bench_track_accuracy
+accuracy_scenes=(none high street_none street_crowd_night)  # at their own seeds, first 12 s
 python=${PYTHON:-/usr/bin/python3}
 [ -x "$bin" ] || { echo "bench: $bin not found (make build first)" >&2; exit 1; }
 
@@ -107,6 +110,7 @@ total=$(( (${#scenarios[@]} + 2 * ${#extra_seeds[@]}) * (1 + runs_per_scene) + n
 [ "$quick" != 2 ] && for sc in "${scenarios[@]}"; do [ "$sc" = e_shape ] && total=$((total + 1)); done  # --loop off
 [ "$quick" != 2 ] && total=$((total + 2))  # ablation, overlay
 [ -x "$tracker_bin" ] && [ "$quick" != 2 ] && total=$((total + 1))
+[ -x "$accuracy_bin" ] && [ "$quick" != 2 ] && total=$((total + ${#accuracy_scenes[@]}))
 step=0
 bench_start=$(date +%s)
 
@@ -214,6 +218,15 @@ record overlay "$overlay_scene" stereo dynavins - "$status" "$wall" "$out/overla
 if [ -x "$tracker_bin" ]; then
   timed "bench_tracker" "$out/bench_tracker.txt" "$tracker_bin"
   record bench_tracker - - - - "$status" "$wall" "$out/bench_tracker.txt" "$tracker_bin"
+fi
+# --- the tracker's pixels against the truth (deterministic) ------------------------------------
+if [ -x "$accuracy_bin" ]; then
+  : > "$out/track_accuracy.txt"
+  for sc in "${accuracy_scenes[@]}"; do
+    timed "bench_track_accuracy $sc" "$out/runs/track_accuracy-$sc.log" "$accuracy_bin" --scenario "$sc" --duration 12
+    record bench_track_accuracy "$sc" stereo - - "$status" "$wall" "$out/track_accuracy.txt" "$accuracy_bin --scenario $sc --duration 12"
+    cat "$out/runs/track_accuracy-$sc.log" >> "$out/track_accuracy.txt"
+  done
 fi
 fi  # not --loop-only
 

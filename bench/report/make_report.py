@@ -897,6 +897,13 @@ def write_report(results_dir, meta, manifest, runs, figures):
         lines = [l.rstrip() for l in open(bt) if not l.startswith("[") and l.strip()]
         L += ["Tracker alone on one core (`bench_tracker`: 150 features, the simulated scene and the real "
               "EuRoC clip):", "", "```"] + lines + ["```", ""]
+    ta = os.path.join(results_dir, "track_accuracy.txt")
+    if os.path.isfile(ta):
+        lines = [l.rstrip() for l in open(ta) if not l.startswith("[") and l.strip()]
+        L += ["Tracker accuracy against the simulator's truth (`bench_track_accuracy --scenario S --duration 12`: "
+              "static features; track error against the point fixed at the track's first observation, residuals "
+              "of each track's best-fitting 3-D point, the stereo match; px at a 460 px focal length):", "",
+              "```"] + lines + ["```", ""]
 
     L += ["## Every run", ""] + table_runs(runs) + [""]
     if gens:
