@@ -77,7 +77,7 @@ int main(int argc, char** argv) {
   app.add_option("--seed", seed, "Noise seed (default: the scenario's)");
   app.add_option("--duration", duration, "Seconds to simulate (default: the scenario's)");
   app.add_flag("--mono", mono, "Left image only");
-  app.add_option("--set", sets, "Override a tracker option by its config key: --set key=value (repeatable)");
+  app.add_option("--set", sets, "Override an option by its config key, --set key=value (repeatable; only the tracker's keys act here)");
   CLI11_PARSE(app, argc, argv);
 
   std::string path = scenario;
