@@ -28,10 +28,7 @@ class TrackTruth {
   TrackTruth(const sim::ScenarioSource& src, const sim::Scenario& sc) : src_(src), sc_(sc) {}
   void operator()(const TrackedFrame& f) {
     const double t = (f.t_ns - sc_.epoch_ns) * 1e-9;
-    Eigen::Isometry3d T_wb = Eigen::Isometry3d::Identity();
-    T_wb.linear() = sc_.body->rotation(t);
-    T_wb.translation() = sc_.body->position(t);
-    const Eigen::Isometry3d T_wc = T_wb * sc_.rig.T_body_cam0;
+    const Eigen::Isometry3d T_wc = sc_.body->pose(t) * sc_.rig.T_body_cam0;
     const cv::Mat& depth = src_.last_left().depth;
     for (const TrackedFeature& tf : f.features) {
       if (tf.sim_label != 0) continue;

@@ -117,9 +117,7 @@ int main(int argc, char** argv) {
     StereoFrame frame = *f;
     if (mono) frame.right = cv::Mat();
     const double t = static_cast<double>(f->t_ns - sc->epoch_ns) * 1e-9;
-    Eigen::Isometry3d T_wb = Eigen::Isometry3d::Identity();
-    T_wb.linear() = sc->body->rotation(t);
-    T_wb.translation() = sc->body->position(t);
+    const Eigen::Isometry3d T_wb = sc->body->pose(t);
     const Eigen::Isometry3d T_wc = T_wb * sc->rig.T_body_cam0, T_wc1 = T_wb * sc->rig.T_body_cam1;
     std::optional<Eigen::Matrix3d> R_prev_curr;
     if (prev_T_wc) R_prev_curr = prev_T_wc->linear().transpose() * T_wc.linear();

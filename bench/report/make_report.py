@@ -892,18 +892,18 @@ def write_report(results_dir, meta, manifest, runs, figures):
           "real-time factor = data seconds / wall seconds at `--rate 0`.", ""]
     L += speed_summary_lines(runs) + [""]
     L += ["BA time ratio DynaVINS / Huber, same run set:", ""] + ba_ratio_lines(runs, scenarios) + [""]
-    bt = os.path.join(results_dir, "bench_tracker.txt")
-    if os.path.isfile(bt):
-        lines = [l.rstrip() for l in open(bt) if not l.startswith("[") and l.strip()]
-        L += ["Tracker alone on one core (`bench_tracker`: 150 features, the simulated scene and the real "
-              "EuRoC clip):", "", "```"] + lines + ["```", ""]
-    ta = os.path.join(results_dir, "track_accuracy.txt")
-    if os.path.isfile(ta):
-        lines = [l.rstrip() for l in open(ta) if not l.startswith("[") and l.strip()]
-        L += ["Tracker accuracy against the simulator's truth (`bench_track_accuracy --scenario S --duration 12`: "
-              "static features; track error against the point fixed at the track's first observation, residuals "
-              "of each track's best-fitting 3-D point, the stereo match; px at a 460 px focal length):", "",
-              "```"] + lines + ["```", ""]
+    # A bench program's printout, verbatim (log lines dropped), under its caption.
+    for name, caption in [
+            ("bench_tracker.txt", "Tracker alone on one core (`bench_tracker`: 150 features, the simulated scene "
+                                  "and the real EuRoC clip):"),
+            ("track_accuracy.txt", "Tracker accuracy against the simulator's truth (`bench_track_accuracy --scenario S "
+                                   "--duration 12`: static features; track error against the point fixed at the "
+                                   "track's first observation, residuals of each track's best-fitting 3-D point, the "
+                                   "stereo match; px at a 460 px focal length):")]:
+        path = os.path.join(results_dir, name)
+        if os.path.isfile(path):
+            lines = [l.rstrip() for l in open(path) if not l.startswith("[") and l.strip()]
+            L += [caption, "", "```"] + lines + ["```", ""]
 
     L += ["## Every run", ""] + table_runs(runs) + [""]
     if gens:
