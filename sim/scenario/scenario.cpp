@@ -157,6 +157,8 @@ std::shared_ptr<const Scenario> build_scenario(const ScenarioSpec& spec, std::op
   street.seed = spec.world_seed;
   street.x_min = spec.world_x_min;
   street.x_max = spec.world_x_max;
+  street.avenue_y = spec.avenue_y;
+  street.cross_street_x = spec.cross_street_x;
   street.moving_vehicles = false;
   auto world = std::make_shared<World>(make_street_scene(street));
   uint64_t texture_seed = s->spec.seed * 1000;

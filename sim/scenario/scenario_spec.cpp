@@ -1,5 +1,6 @@
 #include "sim/scenario/scenario_spec.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <filesystem>
 #include <set>
@@ -117,11 +118,18 @@ ScenarioSpec load_scenario(const std::string& path) {
 
   const cv::FileNode world = root["world"];
   if (!world.empty()) {
-    r.only(world, "world", {"x_min", "x_max", "seed"});
+    r.only(world, "world", {"x_min", "x_max", "seed", "avenues", "cross_streets"});
     s.world_x_min = r.number(world, "x_min", false, s.world_x_min);
     s.world_x_max = r.number(world, "x_max", false, s.world_x_max);
     s.world_seed = static_cast<uint64_t>(r.number(world, "seed", false, static_cast<double>(s.world_seed)));
     if (s.world_x_max <= s.world_x_min) r.fail("world.x_max", "must exceed world.x_min");
+    if (!world["avenues"].empty()) s.avenue_y = r.numbers(world, "avenues", 1);
+    if (!world["cross_streets"].empty()) s.cross_street_x = r.numbers(world, "cross_streets", 1);
+    // Two avenues closer than a block would put buildings of one into the other's road.
+    std::vector<double> a = s.avenue_y;
+    std::sort(a.begin(), a.end());
+    for (std::size_t k = 0; k + 1 < a.size(); ++k)
+      if (a[k + 1] - a[k] < 50) r.fail("world.avenues", "must be at least 50 m apart (one city block)");
   }
 
   const cv::FileNode motion = root["motion"];

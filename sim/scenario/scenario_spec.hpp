@@ -34,9 +34,11 @@ struct ScenarioSpec {
   std::string file;  ///< where it was loaded from
   uint64_t seed = 1;
   double duration = 0;  ///< [s]; 0 = the whole path
-  // World: the street preset (an avenue along x with a cross street, buildings, parked cars).
+  // World: the street preset (avenues along x crossed by streets along y, buildings, parked cars).
   double world_x_min = -40, world_x_max = 160;
   uint64_t world_seed = 7;
+  std::vector<double> avenue_y{0.0};         ///< world.avenues: y of each avenue [m]
+  std::vector<double> cross_street_x{60.0};  ///< world.cross_streets: x of each cross street [m]
   // Motion of the body (IMU) frame: a geometric path (x, y, z corners) with a motion profile.
   std::string profile = "drone";  ///< car | drone | handheld
   double cruise_speed = 0;        ///< [m/s]; 0 = the profile's

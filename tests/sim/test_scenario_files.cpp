@@ -139,7 +139,8 @@ TEST_CASE("The street family: every traffic scene is its static twin's drive", "
   const std::pair<const char*, const char*> pairs[] = {{"street_crowd", "street_none"},
                                                        {"street_crowd_night", "street_none"},
                                                        {"street_jam", "street_none"},
-                                                       {"street_follow", "street_follow_none"}};
+                                                       {"street_follow", "street_follow_none"},
+                                                       {"street_turns", "street_turns_none"}};
   for (const auto& [scene, twin_name] : pairs) {
     INFO(scene);
     const auto s = load_scenario((kScenarios / (std::string(scene) + ".yaml")).string());
@@ -148,6 +149,8 @@ TEST_CASE("The street family: every traffic scene is its static twin's drive", "
     CHECK_FALSE(s.objects.empty());
     CHECK(s.waypoints == twin.waypoints);
     CHECK(s.world_seed == twin.world_seed);
+    CHECK(s.avenue_y == twin.avenue_y);
+    CHECK(s.cross_street_x == twin.cross_street_x);
     CHECK(s.seed == twin.seed);
     CHECK(s.duration == twin.duration);
   }

@@ -21,7 +21,7 @@ std::string write_yaml(const std::string& name, const std::string& body) {
 TEST_CASE("load_scenario reads every part of a scenario", "[scenario]") {
   const auto path = write_yaml("ok.yaml",
                                "name: t\nseed: 3\nduration: 12.5\nphotometric: night\n"
-                               "world: { x_min: -10, x_max: 90, seed: 5 }\n"
+                               "world: { x_min: -10, x_max: 90, seed: 5, avenues: [0, 60], cross_streets: [40] }\n"
                                "motion: { profile: car, cruise_speed: 4, waypoints: [0, 0, 1.5, 50, 0, 1.5] }\n"
                                "objects:\n"
                                "  - { kind: truck, motion: lane, x0: 30, y: -1.75, speed: 3 }\n"
@@ -34,6 +34,8 @@ TEST_CASE("load_scenario reads every part of a scenario", "[scenario]") {
   CHECK(s.duration == 12.5);
   CHECK(s.photometric == "night");
   CHECK(s.world_x_max == 90);
+  CHECK(s.avenue_y == std::vector<double>{0, 60});
+  CHECK(s.cross_street_x == std::vector<double>{40});
   CHECK(s.profile == "car");
   REQUIRE(s.waypoints.size() == 2);
   CHECK(s.waypoints[1] == Eigen::Vector3d(50, 0, 1.5));
@@ -74,6 +76,8 @@ TEST_CASE("load_scenario: a wrong, unknown or missing key is an error naming key
   const std::string motion = "motion: { waypoints: [0, 0, 1.5, 50, 0, 1.5] }\n";
   auto p = write_yaml("typo.yaml", "name: t\nsede: 3\n" + motion);
   CHECK_THROWS_WITH(load_scenario(p), Catch::Contains(p) && Catch::Contains("sede: unknown key"));
+  p = write_yaml("avenues.yaml", "name: t\nworld: { avenues: [0, 30] }\n" + motion);
+  CHECK_THROWS_WITH(load_scenario(p), Catch::Contains("world.avenues: must be at least 50 m apart"));
   p = write_yaml("nomotion.yaml", "name: t\n");
   CHECK_THROWS_WITH(load_scenario(p), Catch::Contains("motion: missing"));
   p = write_yaml("kind.yaml", "name: t\n" + motion + "objects:\n  - { kind: bus, motion: lane, x0: 0, y: 0, speed: 1 }\n");
