@@ -43,6 +43,7 @@ WindowSolveOptions solve_options(const EstimatorOptions& o, const EstimatorMode&
   s.settle_tolerance = o.settle_tolerance;
   s.max_alternations = o.max_alternations;
   s.zero_velocity_sigma = o.zero_velocity_sigma;
+  s.acc_bias_prior_sigma = o.acc_bias_prior_sigma;
   s.margin_feature_thresh = o.margin_feature_thresh;
   s.weighted_huber = o.weighted_huber;
   s.weights.kept_full_weight = o.kept_full_weight;

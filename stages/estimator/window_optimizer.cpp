@@ -9,6 +9,7 @@
 #include <ceres/ceres.h>
 #include <spdlog/spdlog.h>
 
+#include "stages/estimator/factors/acc_bias_prior_factor.hpp"
 #include "stages/estimator/factors/imu_factor.hpp"
 #include "stages/estimator/factors/reprojection_factors.hpp"
 #include "stages/estimator/factors/zero_velocity_factor.hpp"
@@ -225,6 +226,9 @@ class WindowProblem {
     add_states(s, newest, opt);
     if (prior) add_cost(std::make_shared<MarginalizationFactor>(prior), nullptr, prior_blocks);
     add_imu(s, newest, opt);
+    // Until the first marginalisation the bias prior sits on the oldest slot; from then on the prior carries it.
+    if (!prior && opt.acc_bias_prior_sigma > 0)
+      add_cost(std::make_shared<AccBiasPriorFactor>(opt.acc_bias_prior_sigma), nullptr, {s.speed_bias[0].data()});
     add_zero_velocity(s, newest, opt);
     add_visual(s, newest, features, opt);
   }
@@ -437,6 +441,8 @@ void WindowOptimizer::marginalize_oldest(WindowState& s, int newest, WindowFeatu
                {pose0, sb0, s.pose[1].data(), s.speed_bias[1].data()}, {0, 1}});
   }
   if (s.still[0]) info->add({std::make_shared<ZeroVelocityFactor>(opt_.zero_velocity_sigma), nullptr, {sb0}, {0}});
+  if (!prior_ && opt_.acc_bias_prior_sigma > 0)
+    info->add({std::make_shared<AccBiasPriorFactor>(opt_.acc_bias_prior_sigma), nullptr, {sb0}, {0}});
   for (auto& [id, f] : features.all()) {
     if (f.start_slot != 0 || !f.in_ba()) continue;
     // A feature the robust BA rejected would poison the prior forever (paper III; margin_feature_thresh).

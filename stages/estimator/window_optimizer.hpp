@@ -35,6 +35,9 @@ struct WindowSolveOptions {
   double margin_feature_thresh = 0.1;  ///< features under this weight stay out of the prior (dynavins)
   bool weighted_huber = true;  ///< dynavins: Huber loss on each weighted observation too (not the paper's)
   double zero_velocity_sigma = 0.01;  ///< m/s, of the zero-velocity factor on slots found at rest
+  /// m/s², ours (issue 23; 0 = off, as VINS-Fusion): zero-mean prior on the first window's accelerometer
+  /// bias, carried on by the marginalisation (acc_bias_prior_factor.hpp; key acc_bias_prior_sigma).
+  double acc_bias_prior_sigma = 0.0;
   /// Ours (dynavins, mono only; 0 = off): a feature whose best-fit depth is more than this many times
   /// the largest distance between its anchor camera and the others that saw it in the window (parallax
   /// under 1/K rad), while the median depth of the features in use is within that reach, stays out of the
