@@ -39,7 +39,7 @@ const std::vector<OptionSpec>& option_specs() {
       {"settle_tolerance", &O::settle_tolerance, {0, 1, true}, "", "a weight moving less than this in one step has settled (dynavins)"},
       {"max_alternations", &O::max_alternations, {1, 20}, "", "weights <-> states rounds per window solve (dynavins)"},
       {"zero_velocity_sigma", &O::zero_velocity_sigma, {1e-4, 1}, "m/s", "sigma of the zero-velocity factor (zupt)"},
-      {"acc_bias_prior_sigma", &O::acc_bias_prior_sigma, {0, 10}, "m/s^2", "prior on the accelerometer bias at the start, per axis, kept by the marginalisation (ours, issue 23; off: better on the day streets, much worse at night, README); 0 = off"},
+      {"acc_bias_prior_sigma", &O::acc_bias_prior_sigma, {0, 10}, "m/s^2", "prior on the accelerometer bias at the start, per axis, kept by the marginalisation (ours, issue 23; off: helps the city-block drive, costs the other streets and the night, README); 0 = off"},
       {"imu_max_gap", &O::imu_max_gap, {0.01, 1}, "s", "an IMU outage longer than this resets the estimator; shorter ones are bridged"},
       // IMU (continuous-time standard deviations).
       {"acc_n", &O::acc_n, {0, 10, true}, "m/s^2/sqrt(Hz)", "accelerometer noise", true},

@@ -65,8 +65,8 @@ struct EstimatorOptions {
   int max_alternations = 4;        ///< weights <-> states rounds per window solve (dynavins)
   double zero_velocity_sigma = 0.01;  ///< m/s, of the zero-velocity factor on frames found at rest
   /// m/s², ours (issue 23): zero-mean prior on the accelerometer bias at the start, carried on by the
-  /// marginalisation (a filter's initial bias covariance); 0 = off, as VINS-Fusion. Off by default: better
-  /// on the day streets, worse on `none` and much worse at night in stereo (README, "Street scenes").
+  /// marginalisation (a filter's initial bias covariance); 0 = off, as VINS-Fusion. Off by default: in stereo
+  /// it helps the city-block drive and costs `none`, the once-turning streets and the night (README).
   double acc_bias_prior_sigma = 0.0;
   double imu_max_gap = 0.1;  ///< s; a longer IMU outage inside an interval resets the estimator
 
