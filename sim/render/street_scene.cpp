@@ -24,8 +24,7 @@ Eigen::Isometry3d planar_pose(double x, double y, double yaw) {
 /// along `along` (a unit axis) from s_min to s_max; building fronts stand `front` from its centre line
 /// on `side` (+1: left of `along`); [lo, hi] intervals of `keep_clear` (in s) are left open.
 void line_street(World& world, Rng& rng, const Eigen::Vector2d& origin, const Eigen::Vector2d& along, int side,
-                 double s_min, double s_max, double front, const std::vector<std::pair<double, double>>& keep_clear,
-                 bool with_walls) {
+                 double s_min, double s_max, double front, const std::vector<std::pair<double, double>>& keep_clear) {
   const Eigen::Vector2d left(-along.y(), along.x());
   const double yaw = std::atan2(along.y(), along.x()) + (side > 0 ? kPi : 0.0);
   double s = s_min;
@@ -50,7 +49,7 @@ void line_street(World& world, Rng& rng, const Eigen::Vector2d& origin, const Ei
     const double height = rng.uniform(6.0, 22.0);
     const Eigen::Vector2d centre = origin + 0.5 * (s0 + s1) * along + side * (front + 0.5 * depth) * left;
     world.add_building(centre, yaw, s1 - s0, depth, height, rng.next());
-    if (gap > 0.0 && with_walls) {
+    if (gap > 0.0) {
       const Eigen::Vector2d base = origin + side * (front + 0.4) * left;
       world.add_wall(base + s1 * along, base + (s1 + gap) * along, rng.uniform(1.8, 2.6), rng.next());
     }
@@ -94,7 +93,7 @@ World make_street_scene(const StreetSceneOptions& o) {
   for (double y : avenues)
     for (int side : {-1, 1})
       line_street(world, rng, Eigen::Vector2d(0.0, y), Eigen::Vector2d::UnitX(), side, o.x_min, o.x_max, front,
-                  junctions, true);
+                  junctions);
 
   // Parked cars on the avenues' parking strips (static world), with irregular spacing.
   for (double y : avenues) {
@@ -116,8 +115,7 @@ World make_street_scene(const StreetSceneOptions& o) {
     if (s1 - s0 < 8.0) continue;
     for (double x : crosses)
       for (int side : {-1, 1})
-        line_street(world, rng, Eigen::Vector2d(x, 0.0), Eigen::Vector2d::UnitY(), side, s0, s1, cross_half, {},
-                    true);
+        line_street(world, rng, Eigen::Vector2d(x, 0.0), Eigen::Vector2d::UnitY(), side, s0, s1, cross_half, {});
   }
 
   if (o.moving_vehicles) {
