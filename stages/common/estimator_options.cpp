@@ -64,6 +64,7 @@ const std::vector<OptionSpec>& option_specs() {
       {"zupt", &O::zupt, {}, "", "zero-velocity update (ours, OpenVINS' keys)"},
       {"zupt_max_velocity", &O::zupt_max_velocity, {0, 10}, "m/s", "at rest only below this speed of the last solve"},
       {"zupt_max_disparity", &O::zupt_max_disparity, {0, 50}, "px", "at rest only below this median rotation-compensated motion"},
+      {"zupt_imu", &O::zupt_imu, {}, "", "at rest only if the IMU's velocity since the last moving solve is under zupt_max_velocity too; stereo: a solve that leaves the IMU-only path from the last rest frame (3 sigma of acc_n) has its weights judged on that path (ours, issue 23)"},
   };
   return kTable;
 }

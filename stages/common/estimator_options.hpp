@@ -115,6 +115,12 @@ struct EstimatorOptions {
   bool zupt = true;
   double zupt_max_velocity = 0.1;  ///< m/s
   double zupt_max_disparity = 0.5;  ///< px (median, at VINS' nominal 460 px focal length)
+  /// Ours (issue 23): the IMU arbitrates around a standstill. A frame is at rest only if the velocity the
+  /// IMU integrated since the last moving solve is under `zupt_max_velocity` too (a truck driving off with
+  /// the camera keeps the image still), and (stereo) once the solve departs from the IMU-only path from the
+  /// last rest frame by more than 3 σ of `acc_n`, the weight step judges the frames after that rest frame
+  /// on the path until the window has moved past it (imu_path_from_rest.hpp).
+  bool zupt_imu = true;
 
   std::set<std::string> keys_from_file;      ///< which options the file set (the rest are defaults)
   std::set<std::string> keys_from_override;  ///< which options a command line `--set key=value` set

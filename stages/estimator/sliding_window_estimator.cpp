@@ -9,6 +9,7 @@
 #include <spdlog/spdlog.h>
 
 #include "stages/common/so3.hpp"
+#include "stages/estimator/imu_path_from_rest.hpp"
 #include "stages/estimator/initialization/gravity_alignment.hpp"
 #include "stages/estimator/initialization/gyro_bias_estimator.hpp"
 #include "stages/estimator/initialization/init_frame_history.hpp"
@@ -96,6 +97,8 @@ struct SlidingWindowEstimator::Impl {
   void pnp_newest();
   std::string failure_reason(const Eigen::Vector3d& last_p, const Eigen::Quaterniond& last_q);
   void slide(bool keep_second_newest);
+  bool imu_agrees_still();
+  void follow_rest_path(bool still);
   void fill_output(WindowEstimate& e);
   Keyframe make_keyframe(int slot) const;
   /// Appends the keyframes of slots [0, end) not handed out yet (time order).
@@ -122,6 +125,9 @@ struct SlidingWindowEstimator::Impl {
   int64_t last_emitted_t_ns = INT64_MIN;  ///< newest keyframe handed out (each goes out once)
   InitFrameHistory init_history;  ///< mono, before tracking: the last 2W+1 frames (initialize_mono_wide)
   int scale_failures = 0;         ///< consecutive mono attempts with the parallax but not the scale
+  ImuStillVelocity imu_still;     ///< zupt_imu: the IMU's velocity since the last moving solve
+  ImuPathFromRest rest_path;      ///< zupt_imu: the IMU-only path from the last frame at rest
+  bool judge_on_rest_path = false;  ///< zupt_imu: the solve left that path; the weight step uses it
 };
 
 void SlidingWindowEstimator::Impl::clear_window() {
@@ -136,10 +142,37 @@ void SlidingWindowEstimator::Impl::clear_window() {
 
 void SlidingWindowEstimator::Impl::reset_all() {
   clear_window();
+  imu_still.restart(Eigen::Vector3d::Zero());
+  rest_path.clear();
+  judge_on_rest_path = false;
   optimizer.reset();
   init_history.clear();
   scale_failures = 0;
   tracking = false;
+}
+
+// zupt_imu: the image found the newest frame still; is the IMU's velocity since the last moving solve small
+// too? (standstill_detector.hpp)
+bool SlidingWindowEstimator::Impl::imu_agrees_still() {
+  if (!opt.zupt_imu || !state.preint[newest]) return true;
+  const int i = newest - 1;
+  imu_still.add(*state.preint[newest], state.q(i), state.ba(i), state.bg(i), opt.g_norm);
+  return imu_still.velocity().norm() < opt.zupt_max_velocity;
+}
+
+// zupt_imu: carries the IMU-only path from the last rest frame on to the newest frame, or ends it: at a new
+// rest (re-anchored after the solve), when the IMU chain breaks, or once every slot of the window is past
+// the rest frame (nothing before the drive-off is left to hold the solve, and the weights have their
+// momentum by then).
+void SlidingWindowEstimator::Impl::follow_rest_path(bool still) {
+  if (rest_path.empty()) return;
+  const imu::ImuPreintegration* pre = state.preint[newest].get();
+  if (still || !pre || state.t_ns[0] > rest_path.anchor_t_ns()) {
+    rest_path.clear();
+    judge_on_rest_path = false;
+    return;
+  }
+  rest_path.extend(state.t_ns[newest], *pre, opt.g_norm);
 }
 
 void SlidingWindowEstimator::Impl::place_frame(const TrackedFrame& frame) {
@@ -560,10 +593,29 @@ WindowEstimate SlidingWindowEstimator::Impl::process(const TrackedFrame& frame, 
     const Eigen::Matrix3d R_prev_new = state.camera(newest - 1).R.transpose() * state.camera(newest).R;
     const StandstillCheck rest =
         check_standstill(features, newest, R_prev_new, state.v(newest - 1).norm(), standstill_options(opt));
-    state.still[newest] = rest.still ? 1 : 0;
-    e.standstill = rest.still;
+    const bool still = rest.still && imu_agrees_still();
+    state.still[newest] = still ? 1 : 0;
+    e.standstill = still;
+    follow_rest_path(still);
     features.triangulate(cams(), T_c0c1, mode.stereo);
-    e.solve = optimizer.solve(state, newest, features);
+    // Once the solve has left the IMU's path it has shown that it follows something else: the path judges
+    // until it ends, not only while the solve is away from it (it comes back because of that judging).
+    if (!rest_path.empty() && !judge_on_rest_path &&
+        rest_path.departed(state.t_ns[newest], state.p(newest), opt.acc_n)) {
+      judge_on_rest_path = true;
+      spdlog::debug("t={:.3f}: the solve left the IMU's path from the rest at {:.3f}; the weights are judged on it",
+                    frame.t_ns * 1e-9, rest_path.anchor_t_ns() * 1e-9);
+    }
+    e.solve = optimizer.solve(state, newest, features, judge_on_rest_path ? &rest_path : nullptr);
+    if (!still) {
+      imu_still.restart(state.v(newest));
+    } else if (opt.zupt_imu && mode.stereo && imu_still.has_biases()) {
+      // Stereo only: in mono the solve's scale is the IMU's own estimate, and a departure is as much that
+      // scale settling after a stop as anything followed (standstill_minute, mono: 0.022 -> 0.024 m, a 0.29 m
+      // jump at the drive-off; README, "Street scenes").
+      rest_path.anchor(state.t_ns[newest], state.p(newest), state.q(newest), imu_still.velocity(), state.v(newest),
+                       imu_still.ba(), imu_still.bg());
+    }
     features.remove_bad_depths();
     const std::string why = failure_reason(last_p, last_q);
     if (!why.empty()) return fail(why, -1);

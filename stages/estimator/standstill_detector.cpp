@@ -1,9 +1,26 @@
 #include "stages/estimator/standstill_detector.hpp"
 
 #include <algorithm>
+#include <cmath>
 #include <vector>
 
+#include "stages/imu/imu_preintegration.hpp"
+
 namespace dynavins::estimator {
+
+void ImuStillVelocity::add(const imu::ImuPreintegration& pre, const Eigen::Quaterniond& q, const Eigen::Vector3d& ba,
+                           const Eigen::Vector3d& bg, double gravity) {
+  if (!has_biases_) {
+    ba_ = ba;
+    bg_ = bg;
+    has_biases_ = true;
+  }
+  Eigen::Vector3d alpha, beta;
+  Eigen::Quaterniond gamma;
+  pre.corrected_deltas(ba_, bg_, alpha, gamma, beta);
+  const double T = pre.sum_dt();
+  v_ = std::exp(-T / kForgetS) * v_ + Eigen::Vector3d(0.0, 0.0, -gravity) * T + q * beta;  // Vj = Vi + g T + Ri β
+}
 
 StandstillCheck check_standstill(const WindowFeatures& features, int newest, const Eigen::Matrix3d& R_prev_new,
                                 double speed, const StandstillOptions& options) {

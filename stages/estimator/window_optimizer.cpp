@@ -13,6 +13,7 @@
 #include "stages/estimator/factors/imu_factor.hpp"
 #include "stages/estimator/factors/reprojection_factors.hpp"
 #include "stages/estimator/factors/zero_velocity_factor.hpp"
+#include "stages/estimator/imu_path_from_rest.hpp"
 #include "stages/estimator/marginalization/marginalization_factor.hpp"
 #include "stages/estimator/marginalization/marginalization_info.hpp"
 #include "stages/estimator/pose_manifold.hpp"
@@ -347,15 +348,23 @@ class StateSolver {
 /// The weight step (paper eq. 10 in closed form, solve_feature_weight) with the states fixed.
 class WeightStep {
  public:
-  WeightStep(const WindowState& s, int newest, const WindowSolveOptions& opt, SolveStats& st)
-      : s_(s), newest_(newest), opt_(opt), st_(st), cameras_(newest + 1) {}
+  WeightStep(const WindowState& s, int newest, const WindowSolveOptions& opt, const ImuPathFromRest* rest_path,
+             SolveStats& st)
+      : s_(s), newest_(newest), opt_(opt), rest_path_(rest_path), st_(st), cameras_(newest + 1) {}
 
   /// Updates every feature's w_j from its residual r_j at the current states; returns the share of
   /// weights that moved less than settle_tolerance.
   double operator()(const std::vector<WindowFeature*>& features) {
     const auto t0 = Clock::now();
     // The states are fixed during the weight step: each slot's camera poses once, not per observation.
-    for (int k = 0; k <= newest_; ++k) cameras_[k] = {s_.camera(k, 0), s_.camera(k, 1)};
+    for (int k = 0; k <= newest_; ++k) {
+      const ImuPathFromRest::Pose* on_path = rest_path_ ? rest_path_->after_anchor(s_.t_ns[k]) : nullptr;
+      if (on_path) {
+        cameras_[k] = {s_.camera_at(on_path->p, on_path->q, 0), s_.camera_at(on_path->p, on_path->q, 1)};
+      } else {
+        cameras_[k] = {s_.camera(k, 0), s_.camera(k, 1)};
+      }
+    }
     auto camera = [this](int k, int c) -> const CameraPose& { return cameras_[k][c]; };
     int settled = 0;
     const bool judge_depth = !opt_.stereo && opt_.mono_max_depth_baselines > 0;  // depth_unobservable
@@ -378,6 +387,7 @@ class WeightStep {
   const WindowState& s_;
   int newest_;
   const WindowSolveOptions& opt_;
+  const ImuPathFromRest* rest_path_;
   SolveStats& st_;
   std::vector<std::array<CameraPose, 2>> cameras_;
   FeatureGeometry geometry_;
@@ -388,8 +398,8 @@ class WeightStep {
 /// `alternating_converge` with Ceres converged, `max_alternations` is reached or the budget is spent.
 /// Afterwards w̄_j = w_j and n_j grows by one (the momentum of eq. 9 for the next solve).
 void alternate(const WindowState& s, int newest, const std::vector<WindowFeature*>& features,
-               const WindowSolveOptions& opt, StateSolver& solver, SolveStats& st) {
-  WeightStep weight_step(s, newest, opt, st);
+               const WindowSolveOptions& opt, const ImuPathFromRest* rest_path, StateSolver& solver, SolveStats& st) {
+  WeightStep weight_step(s, newest, opt, rest_path, st);
   // Start from the previous weights (momentum's w̄) so "settled" compares against where we were.
   for (WindowFeature* f : features) f->weight = f->weight_prev;
   weight_step(features);
@@ -408,7 +418,8 @@ void alternate(const WindowState& s, int newest, const std::vector<WindowFeature
 
 }  // namespace
 
-SolveStats WindowOptimizer::solve(WindowState& s, int newest, WindowFeatures& features) {
+SolveStats WindowOptimizer::solve(WindowState& s, int newest, WindowFeatures& features,
+                                  const ImuPathFromRest* rest_path) {
   SolveStats st;
   const auto t_ba = Clock::now();
   const WindowGauge gauge = WindowGauge::of(s);
@@ -416,7 +427,7 @@ SolveStats WindowOptimizer::solve(WindowState& s, int newest, WindowFeatures& fe
   st.features_in_window = static_cast<int>(window.features().size());
   StateSolver solver(window.problem(), opt_, st);
   if (opt_.loss == BaLoss::Dynavins) {
-    alternate(s, newest, window.features(), opt_, solver, st);
+    alternate(s, newest, window.features(), opt_, rest_path, solver, st);
   } else {
     solver.run(solver.iterations_left());  // eq. 1, Huber loss on the visual residuals
   }

@@ -20,6 +20,7 @@
 namespace dynavins::estimator {
 
 class MarginalizationInfo;
+class ImuPathFromRest;
 
 struct WindowSolveOptions {
   BaLoss loss = BaLoss::Dynavins;
@@ -50,8 +51,11 @@ class WindowOptimizer {
   explicit WindowOptimizer(WindowSolveOptions options);
   ~WindowOptimizer();
 
-  /// Solves slots 0..newest. Updates the states, feature depths and (dynavins) weights in place.
-  SolveStats solve(WindowState& s, int newest, WindowFeatures& features);
+  /// Solves slots 0..newest. Updates the states, feature depths and (dynavins) weights in place. With
+  /// `rest_path` (dynavins), the weight step judges the slots that path reaches on it instead of on the
+  /// solved states (imu_path_from_rest.hpp).
+  SolveStats solve(WindowState& s, int newest, WindowFeatures& features,
+                   const ImuPathFromRest* rest_path = nullptr);
 
   /// Marginalises slot 0 (the oldest keyframe) into the prior; call before the window slides.
   void marginalize_oldest(WindowState& s, int newest, WindowFeatures& features);

@@ -35,11 +35,13 @@ struct WindowState {
   Eigen::Quaterniond q(int k) const { return Eigen::Map<const Eigen::Quaterniond>(pose[k].data() + 3); }
 
   /// cam `c`'s pose in the world at slot k.
-  CameraPose camera(int k, int c = 0) const {
-    const Eigen::Matrix3d R_wb = q(k).toRotationMatrix();
+  CameraPose camera(int k, int c = 0) const { return camera_at(p(k), q(k), c); }
+  /// cam `c`'s pose in the world for the body pose (p_wb, q_wb).
+  CameraPose camera_at(const Eigen::Vector3d& p_wb, const Eigen::Quaterniond& q_wb, int c = 0) const {
+    const Eigen::Matrix3d R_wb = q_wb.toRotationMatrix();
     const Eigen::Quaterniond q_bc(Eigen::Map<const Eigen::Quaterniond>(extrinsic[c].data() + 3));
     const Eigen::Vector3d p_bc(Eigen::Map<const Eigen::Vector3d>(extrinsic[c].data()));
-    return {R_wb * q_bc.toRotationMatrix(), p(k) + R_wb * p_bc};
+    return {R_wb * q_bc.toRotationMatrix(), p_wb + R_wb * p_bc};
   }
 
   /// Copies every state of slot `from` into slot `to` (preintegration moved).
