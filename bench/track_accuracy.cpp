@@ -5,7 +5,11 @@
 //     depth under the pixel) and projected with the true pose into every later frame;
 //   - fit: the best 3-D point of each static track (5+ observations, true poses) and its residuals,
 //     i.e. how well a track's observations agree with each other, whatever its first pixel;
-//   - stereo: each right observation against the true point under the same frame's left pixel.
+//   - stereo: each right observation against the true point under the same frame's left pixel;
+//   - near moving objects: the track error by how close the static track is to a
+//     moving object's pixels, and its mean component along the point's true image motion since the
+//     first observation (negative: the track lags, held back by the object's edge; issue 23's
+//     leading truck, where such tracks make the estimated speed short).
 // The gyro's rotation prediction is the true rotation (the pipeline uses the gyro's).
 //   bench_track_accuracy --scenario street_crowd_night --seed 25 --duration 12 [--mono] [--set k=v]
 #include <algorithm>
@@ -35,6 +39,32 @@ constexpr double kFocal = 460.0;  // errors in pixels of VINS' virtual camera, a
 struct Observation {
   Eigen::Isometry3d T_wc;
   Eigen::Vector2d xy;
+};
+
+/// Chebyshev distance [px] from `px` to the nearest moving-object pixel of `labels`, or reach + 1.
+int moving_distance(const cv::Mat& labels, const Eigen::Vector2d& px, int reach) {
+  const int cx = static_cast<int>(px.x()), cy = static_cast<int>(px.y());
+  int best = reach + 1;
+  for (int y = std::max(0, cy - reach); y <= std::min(labels.rows - 1, cy + reach); ++y) {
+    const uchar* row = labels.ptr<uchar>(y);
+    for (int x = std::max(0, cx - reach); x <= std::min(labels.cols - 1, cx + reach); ++x)
+      if (row[x] > 0) best = std::min(best, std::max(std::abs(x - cx), std::abs(y - cy)));
+  }
+  return best;
+}
+
+/// Static observations in one band of distance to moving pixels.
+struct NearMovingBand {
+  explicit NearMovingBand(const char* n) : name(n) {}
+  const char* name;
+  std::vector<double> err;  ///< [px] against the truth
+  double lag_sum = 0, lag_good_sum = 0;
+  long lag_good_n = 0;
+  void add(double e, double lag) {
+    err.push_back(e);
+    lag_sum += lag;
+    if (e < 2.0) lag_good_sum += lag, ++lag_good_n;
+  }
 };
 
 void print_stats(const char* name, std::vector<double> v) {
@@ -108,6 +138,10 @@ int main(int argc, char** argv) {
   std::map<int64_t, Eigen::Vector3d> points;        // static tracks' true points (first observation)
   std::map<int64_t, std::vector<Observation>> seen;  // every static observation, for the fit
   std::map<int64_t, int> moving_seen;                // observations on moving objects, per track
+  std::map<int64_t, Eigen::Vector2d> first_px;       // static tracks' first pixel (460 px focal)
+  std::map<int64_t, bool> was_near;                  // static tracks that came within 10 px of a moving object
+  NearMovingBand near[5] = {NearMovingBand("within 10 px"), NearMovingBand("11-20 px"), NearMovingBand("21-40 px"),
+                            NearMovingBand("farther, once within 10"), NearMovingBand("farther, never within 10")};
   std::optional<Eigen::Isometry3d> prev_T_wc;
   long frames = 0, features = 0, with_right = 0;
   SensorEvent e;
@@ -139,11 +173,19 @@ int main(int argc, char** argv) {
       }
       auto it = points.find(tf.id);
       if (it == points.end()) {
-        if (tf.track_length == 1 && z) points.emplace(tf.id, point());
+        if (tf.track_length == 1 && z) points.emplace(tf.id, point()), first_px.emplace(tf.id, kFocal * tf.xy);
         continue;
       }
       const Eigen::Vector3d p = T_wc.inverse() * it->second;
       if (p.z() <= 0) continue;
+      {
+        const int d = moving_distance(src.last_left().labels, tf.px, 40);
+        if (d <= 10) was_near[tf.id] = true;
+        const int band = d <= 10 ? 0 : d <= 20 ? 1 : d <= 40 ? 2 : was_near[tf.id] ? 3 : 4;
+        const Eigen::Vector2d truth = kFocal * (p.head<2>() / p.z()), error = kFocal * tf.xy - truth;
+        const Eigen::Vector2d motion = truth - first_px.at(tf.id);
+        near[band].add(error.norm(), motion.norm() > 1.0 ? error.dot(motion.normalized()) : 0.0);
+      }
       for (int k = 0; k < kBins; ++k)
         if (tf.track_length >= edges[k] && tf.track_length < edges[k + 1])
           by_length[k].push_back(kFocal * (p.head<2>() / p.z() - tf.xy).norm());
@@ -184,5 +226,18 @@ int main(int argc, char** argv) {
     if (obs.size() >= 5) fit_residuals(obs, &fit);
   print_stats("fit (5+ observations)", fit);
   if (!mono) print_stats("stereo", stereo);
+  {
+    std::printf("static observations by distance to moving pixels: error, > 2 px, mean error along the true image motion\n");
+    std::printf("since the first observation (negative: lagging), of all and of those within 2 px\n");
+    for (NearMovingBand& b : near) {
+      if (b.err.empty()) continue;
+      const double n = static_cast<double>(b.err.size());
+      const double drifted = static_cast<double>(std::count_if(b.err.begin(), b.err.end(), [](double e) { return e > 2.0; }));
+      const double lag = b.lag_sum / n, lag_good = b.lag_good_sum / static_cast<double>(std::max(1L, b.lag_good_n));
+      std::sort(b.err.begin(), b.err.end());
+      std::printf("  %-24s n %6zu  p50 %.3f  p90 %.3f px, > 2 px %5.1f %%, along the motion %+.3f px (within 2 px: %+.4f)\n",
+                  b.name, b.err.size(), b.err[b.err.size() / 2], b.err[b.err.size() * 9 / 10], 100.0 * drifted / n, lag, lag_good);
+    }
+  }
   return 0;
 }

@@ -37,7 +37,7 @@ done
 bin=${DYNAVINS:-build/bin/dynavins}
 tracker_bin=${BENCH_TRACKER:-build/bin/bench_tracker}
 accuracy_bin=$(dirname "$tracker_bin")/bench_track_accuracy
-accuracy_scenes=(none high street_none street_crowd_night)  # at their own seeds, first 12 s
+accuracy_scenes=(none high street_none street_crowd_night street_follow)  # at their own seeds, first 12 s
 python=${PYTHON:-/usr/bin/python3}
 [ -x "$bin" ] || { echo "bench: $bin not found (make build first)" >&2; exit 1; }
 

@@ -901,7 +901,8 @@ def write_report(results_dir, meta, manifest, runs, figures):
             ("track_accuracy.txt", "Tracker accuracy against the simulator's truth (`bench_track_accuracy --scenario S "
                                    "--duration 12`: static features; track error against the point fixed at the "
                                    "track's first observation, residuals of each track's best-fitting 3-D point, the "
-                                   "stereo match; px at a 460 px focal length):")]:
+                                   "stereo match; with traffic, the static observations by distance to moving "
+                                   "pixels and how far they lag; px at a 460 px focal length):")]:
         path = os.path.join(results_dir, name)
         if os.path.isfile(path):
             lines = [l.rstrip() for l in open(path) if not l.startswith("[") and l.strip()]

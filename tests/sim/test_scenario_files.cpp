@@ -138,6 +138,7 @@ TEST_CASE("The street family: every traffic scene is its static twin's drive", "
   // r_d compares a scene with its twin: same world, path and noise seed, traffic only (README, "Street scenes").
   const std::pair<const char*, const char*> pairs[] = {{"street_crowd", "street_none"},
                                                        {"street_crowd_night", "street_none"},
+                                                       {"street_crowd_night", "street_none_night"},
                                                        {"street_jam", "street_none"},
                                                        {"street_follow", "street_follow_none"},
                                                        {"street_turns", "street_turns_none"}};
@@ -153,5 +154,18 @@ TEST_CASE("The street family: every traffic scene is its static twin's drive", "
     CHECK(s.cross_street_x == twin.cross_street_x);
     CHECK(s.seed == twin.seed);
     CHECK(s.duration == twin.duration);
+  }
+  // The night twins: the day scene's drive with the night camera.
+  for (const auto& [night, day] : {std::pair<const char*, const char*>{"street_none_night", "street_none"}, {"none_night", "none"}}) {
+    INFO(night);
+    const auto n = load_scenario((kScenarios / (std::string(night) + ".yaml")).string());
+    const auto d = load_scenario((kScenarios / (std::string(day) + ".yaml")).string());
+    CHECK(n.photometric == "night");
+    CHECK(d.photometric == "day");
+    CHECK(n.objects.empty());
+    CHECK(n.waypoints == d.waypoints);
+    CHECK(n.world_seed == d.world_seed);
+    CHECK(n.seed == d.seed);
+    CHECK(n.duration == d.duration);
   }
 }
