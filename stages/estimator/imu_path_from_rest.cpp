@@ -18,16 +18,12 @@ void ImuPathFromRest::anchor(int64_t t_ns, const Eigen::Vector3d& p, const Eigen
 
 void ImuPathFromRest::extend(int64_t t_ns, const imu::ImuPreintegration& pre, double gravity) {
   if (poses_.empty()) return;
-  Eigen::Vector3d alpha, beta;
-  Eigen::Quaterniond gamma;
-  pre.corrected_deltas(ba_, bg_, alpha, gamma, beta);
-  const double T = pre.sum_dt();
-  const Eigen::Vector3d g_w(0.0, 0.0, -gravity);
   const Pose last = poses_.back();
-  // VINS-Mono §VI-B, as ImuPreintegration::evaluate_residual: Pj = Pi + Vi T + ½ g T² + Ri α, Vj = Vi + g T +
-  // Ri β, Qj = Qi γ.
-  poses_.push_back({t_ns, last.p + v_ * T + 0.5 * g_w * T * T + last.q * alpha, (last.q * gamma).normalized()});
-  v_ += g_w * T + last.q * beta;
+  Pose next{t_ns, {}, {}};
+  Eigen::Vector3d v_next;
+  pre.predict(last.p, last.q, v_, ba_, bg_, gravity, next.p, next.q, v_next);
+  poses_.push_back(next);
+  v_ = v_next;
 }
 
 const ImuPathFromRest::Pose* ImuPathFromRest::after_anchor(int64_t t_ns) const {

@@ -199,15 +199,12 @@ bool SlidingWindowEstimator::Impl::predict_newest(const PreintegratedInterval& i
     state.q(i) = Eigen::Quaterniond(gravity_aligned_rotation(f / pre->samples().size()));
     gravity_aligned = true;
   }
-  Eigen::Vector3d alpha, beta;
-  Eigen::Quaterniond gamma;
-  pre->corrected_deltas(ba, bg, alpha, gamma, beta);
-  const double dt = pre->sum_dt();
-  const Eigen::Vector3d g_w(0, 0, -opt.g_norm);
-  const Eigen::Quaterniond qi = state.q(i);
-  state.p(j) = state.p(i) + state.v(i) * dt + 0.5 * g_w * dt * dt + qi * alpha;
-  state.v(j) = state.v(i) + g_w * dt + qi * beta;
-  state.q(j) = (qi * gamma).normalized();
+  Eigen::Vector3d p_j, v_j;
+  Eigen::Quaterniond q_j;
+  pre->predict(state.p(i), state.q(i), state.v(i), ba, bg, opt.g_norm, p_j, q_j, v_j);
+  state.p(j) = p_j;
+  state.v(j) = v_j;
+  state.q(j) = q_j;
   state.ba(j) = ba;
   state.bg(j) = bg;
   state.preint[j] = std::move(pre);

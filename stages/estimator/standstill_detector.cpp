@@ -15,11 +15,11 @@ void ImuStillVelocity::add(const imu::ImuPreintegration& pre, const Eigen::Quate
     bg_ = bg;
     has_biases_ = true;
   }
-  Eigen::Vector3d alpha, beta;
-  Eigen::Quaterniond gamma;
-  pre.corrected_deltas(ba_, bg_, alpha, gamma, beta);
-  const double T = pre.sum_dt();
-  v_ = std::exp(-T / kForgetS) * v_ + Eigen::Vector3d(0.0, 0.0, -gravity) * T + q * beta;  // Vj = Vi + g T + Ri β
+  // Only the velocity is wanted; the position is the origin's (unused).
+  Eigen::Vector3d p_unused;
+  Eigen::Quaterniond q_unused;
+  const Eigen::Vector3d v_kept = std::exp(-pre.sum_dt() / kForgetS) * v_;
+  pre.predict(Eigen::Vector3d::Zero(), q, v_kept, ba_, bg_, gravity, p_unused, q_unused, v_);
 }
 
 StandstillCheck check_standstill(const WindowFeatures& features, int newest, const Eigen::Matrix3d& R_prev_new,

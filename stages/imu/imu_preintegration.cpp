@@ -163,6 +163,19 @@ void ImuPreintegration::corrected_deltas(const Eigen::Vector3d& ba, const Eigen:
   gamma = (gamma_ * exp_q(jacobian_.block<3, 3>(kR, kBg) * dbg)).normalized();
 }
 
+void ImuPreintegration::predict(const Eigen::Vector3d& Pi, const Eigen::Quaterniond& Qi, const Eigen::Vector3d& Vi,
+                                const Eigen::Vector3d& ba, const Eigen::Vector3d& bg, double gravity,
+                                Eigen::Vector3d& Pj, Eigen::Quaterniond& Qj, Eigen::Vector3d& Vj) const {
+  Eigen::Vector3d alpha, beta;
+  Eigen::Quaterniond gamma;
+  corrected_deltas(ba, bg, alpha, gamma, beta);
+  const Eigen::Vector3d g_w(0.0, 0.0, -gravity);
+  const double T = sum_dt_;
+  Pj = Pi + Vi * T + 0.5 * g_w * T * T + Qi * alpha;
+  Vj = Vi + g_w * T + Qi * beta;
+  Qj = (Qi * gamma).normalized();
+}
+
 ImuPreintegration::Vector15 ImuPreintegration::evaluate_residual(
     const Eigen::Vector3d& Pi, const Eigen::Quaterniond& Qi, const Eigen::Vector3d& Vi, const Eigen::Vector3d& Bai,
     const Eigen::Vector3d& Bgi, const Eigen::Vector3d& Pj, const Eigen::Quaterniond& Qj, const Eigen::Vector3d& Vj,

@@ -52,6 +52,13 @@ class ImuPreintegration {
   void corrected_deltas(const Eigen::Vector3d& ba, const Eigen::Vector3d& bg, Eigen::Vector3d& alpha,
                        Eigen::Quaterniond& gamma, Eigen::Vector3d& beta) const;
 
+  /// Body state at the interval's end predicted from (Pi, Qi, Vi) at its start, deltas bias-corrected with
+  /// (ba, bg) and world gravity (0, 0, -gravity) (VINS-Mono §VI-B, what evaluate_residual measures against):
+  /// Pj = Pi + Vi T + ½ g T² + Ri α, Vj = Vi + g T + Ri β, Qj = Qi γ.
+  void predict(const Eigen::Vector3d& Pi, const Eigen::Quaterniond& Qi, const Eigen::Vector3d& Vi,
+               const Eigen::Vector3d& ba, const Eigen::Vector3d& bg, double gravity, Eigen::Vector3d& Pj,
+               Eigen::Quaterniond& Qj, Eigen::Vector3d& Vj) const;
+
   /// The 15-dim residual between states i and j (VINS-Mono §VI-B; IntegrationBase::evaluate), with world
   /// gravity g_w = (0, 0, -gravity): [r_p, r_θ, r_v, r_ba, r_bg], deltas bias-corrected with (Bai, Bgi).
   Vector15 evaluate_residual(const Eigen::Vector3d& Pi, const Eigen::Quaterniond& Qi, const Eigen::Vector3d& Vi,

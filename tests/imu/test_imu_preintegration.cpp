@@ -217,3 +217,21 @@ TEST_CASE("residual vanishes at the true states and sees a perturbation", "[imu]
   const auto r0 = pre.evaluate_residual(a.p_w, qa, a.v_w, z, z, b.p_w, qb, b.v_w, z, z, 0.0);
   CHECK((r0 - r).segment<3>(6).norm() == Approx(9.81 * 0.2).epsilon(1e-9));
 }
+
+TEST_CASE("predict reaches the end state and is what the residual measures against", "[imu][preintegration]") {
+  const SmoothTrajectory tr = wavy_trajectory();
+  const int64_t t0 = 5'000'000'000, t1 = 5'200'000'000;
+  const imu::ImuPreintegration pre = preintegrate(simulate(tr, 200.0, t0, t1).samples);
+  const KinematicState a = tr.evaluate(t0 * 1e-9), b = tr.evaluate(t1 * 1e-9);
+  const Eigen::Quaterniond qa(a.R_wb), qb(b.R_wb);
+  const Eigen::Vector3d z = Eigen::Vector3d::Zero(), ba(0.02, -0.01, 0.03), bg(0.001, 0.002, -0.001);
+  Eigen::Vector3d p, v;
+  Eigen::Quaterniond q;
+  pre.predict(a.p_w, qa, a.v_w, z, z, 9.81, p, q, v);
+  CHECK((p - b.p_w).norm() < 1e-4);
+  CHECK((v - b.v_w).norm() < 1e-4);
+  CHECK(q.angularDistance(qb) < 1e-4);
+  // With other biases too, the predicted state has zero residual (both correct the deltas the same way).
+  pre.predict(a.p_w, qa, a.v_w, ba, bg, 9.81, p, q, v);
+  CHECK(pre.evaluate_residual(a.p_w, qa, a.v_w, ba, bg, p, q, v, ba, bg).norm() < 1e-12);
+}
