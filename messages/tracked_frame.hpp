@@ -35,6 +35,7 @@ struct TrackerStats {
   int patch_recaptured = 0;  ///< first patch taken again: it no longer aligned, or changed size
   int lost_ransac = 0;    ///< rejected by the fundamental-matrix RANSAC (off by default)
   int lost_mask = 0;      ///< dropped for crowding a longer track (min_dist)
+  int uncounted = 0;      ///< tracks the estimator rejected, kept beside max_cnt (StereoTracker::set_rejected)
   int detected = 0;       ///< new corners
   int stereo = 0;         ///< features with a right observation
   int predicted = 0;      ///< features whose KLT started from the IMU-rotation prediction

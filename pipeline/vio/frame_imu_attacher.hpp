@@ -21,6 +21,11 @@ namespace dynavins::pipeline {
 struct TrackerInput {
   StereoFrame frame;
   std::vector<ImuSample> imu;
+  /// How many of the frames before this one the estimator can finish with the data sent before it (an IMU
+  /// sample at or after their time came first: their interval is complete); -1: unknown. At rate 0 the
+  /// tracker waits for the estimator's verdict on those (RejectedTracksFeedback), never on a frame whose
+  /// IMU lies behind an outage still to be replayed.
+  int64_t finishable_before = -1;
 };
 
 class FrameImuAttacher {

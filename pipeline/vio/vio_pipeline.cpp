@@ -1,6 +1,9 @@
 #include "pipeline/vio/vio_pipeline.hpp"
 
+#include <algorithm>
 #include <chrono>
+#include <climits>
+#include <deque>
 #include <memory>
 #include <optional>
 #include <stdexcept>
@@ -34,18 +37,32 @@ struct ReplayRouting {
   std::vector<GroundTruthState>* ground_truth = nullptr;
   FrameImuAttacher attacher;
 
-  bool push_attached(std::optional<TrackerInput> f) { return !f || push_frame(std::move(*f)); }
+  // Frames handed to the tracker so far, the times of those an IMU sample has not yet reached, and the
+  // newest IMU sample time (TrackerInput::finishable_before).
+  int64_t frames_pushed = 0;
+  std::deque<int64_t> unfinishable;
+  int64_t last_imu_ns = INT64_MIN;
+
+  bool push_tracked(TrackerInput f) {
+    while (!unfinishable.empty() && unfinishable.front() <= last_imu_ns) unfinishable.pop_front();
+    f.finishable_before = frames_pushed - static_cast<int64_t>(unfinishable.size());
+    unfinishable.push_back(f.frame.t_ns);
+    ++frames_pushed;
+    return push_frame(std::move(f));
+  }
+  bool push_attached(std::optional<TrackerInput> f) { return !f || push_tracked(std::move(*f)); }
 
   ReplaySinks sinks() {
     ReplaySinks s;
     s.frame = [this](StereoFrame&& f) {
       poll();
       if (!push_imu(imu::FrameTime{f.t_ns})) return false;
-      if (!predict) return push_frame(TrackerInput{std::move(f), {}});
+      if (!predict) return push_tracked(TrackerInput{std::move(f), {}});
       return push_attached(attacher.add_frame(std::move(f)));
     };
     s.imu = [this](ImuSample&& x) {
       poll();
+      last_imu_ns = std::max(last_imu_ns, x.t_ns);
       if (!predict) return push_imu(std::move(x));
       const ImuSample copy = x;
       return push_imu(std::move(x)) && push_attached(attacher.add_imu(copy));
@@ -217,6 +234,7 @@ VioRunResult run_vio(io::SensorSource& source, const VioRunOptions& opt, const V
     };
   }
   p.add_stage("estimator", st.estimator, est_in, into(estimates), [&] {
+    st.rejected.close();  // a tracker waiting for a verdict goes on (also when the estimator failed)
     estimates.close();
     if (keyframes) keyframes->close();
   });

@@ -1,5 +1,6 @@
 #include "pipeline/vio/vio_stages.hpp"
 
+#include <chrono>
 #include <cmath>
 #include <limits>
 #include <type_traits>
@@ -27,6 +28,14 @@ TrackedFrame TrackerStage::process(TrackerInput in) {
     ++(R_prev_curr ? frames_predicted : frames_unpredicted);
   }
   prev_t_ns = in.frame.t_ns;
+  if (rejected) {
+    std::vector<int64_t> ids;
+    if (!wait_for_verdict || in.finishable_before < 0) ids = rejected->latest();
+    else if (!rejected->wait(in.finishable_before, std::chrono::seconds(60), &ids))
+      spdlog::warn("tracker: no verdict from the estimator on {} frames within 60 s; tracking on without it",
+                   in.finishable_before);
+    tracker.set_rejected(std::move(ids));
+  }
   TrackedFrame out = tracker.process(in.frame, R_prev_curr);
   out.received_ns = received_ns;
   features_predicted += out.stats.predicted;
@@ -78,10 +87,24 @@ std::vector<estimator::WindowEstimate> EstimatorStage::process(estimator::Estima
     if (e.status == estimator::EstimatorStatus::Reset) ++resets;
     if (!e.event.empty()) spdlog::info("estimator: t = {} ns: {}", e.t_ns, e.event);
   }
+  if (rejected) {
+    // Frames received and no longer waiting for their IMU (emitted, skipped or ignored) are finished.
+    const int64_t done = pairer.stats().frames_in - static_cast<int64_t>(pairer.waiting_frames());
+    if (!out.empty()) {
+      std::vector<int64_t> ids;
+      for (const auto& f : out.back().features.features)
+        if (f.weight < 0.5f) ids.push_back(f.id);
+      rejected->publish(done, std::move(ids));
+    } else if (done != published_done) {
+      rejected->publish(done, rejected->latest());
+    }
+    published_done = done;
+  }
   return out;
 }
 
 void EstimatorStage::finish() {
+  if (rejected) rejected->close();
   pairer.finish();
   std::vector<Keyframe> rest = estimator.flush_keyframes();
   if (on_keyframe)
@@ -144,6 +167,11 @@ VioStages::VioStages(const VioRunOptions& o, std::function<void(const TrackedFra
       writer{std::move(on_estimate), {}, {}, 0, 0} {
   if (o.loop_mode != loop::LoopMode::Off)
     loop = std::make_unique<LoopStage>(o.loop_mode, o.vocabulary, o.estimator.cameras.at(0));
+  if (o.estimator.rejected_feedback && o.mode.loss == estimator::BaLoss::Dynavins) {
+    tracker.rejected = &rejected;
+    tracker.wait_for_verdict = !o.real_time();
+    estimator.rejected = &rejected;
+  }
 }
 
 void VioStages::collect(VioRunResult& r) const {

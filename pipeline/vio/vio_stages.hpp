@@ -9,7 +9,8 @@
 //   estimator: TrackedFrame | PreintegratedInterval -> WindowEstimate*  (pairs them, runs the window BA)
 //   writer:    WindowEstimate -> the run's sinks
 // Feedback: the estimator publishes its newest NavState to the IMU stage and its gyro bias to the tracker
-// through LatestValue snapshots (never waited on).
+// through LatestValue snapshots (never waited on), and the tracks it rejected to the tracker through
+// RejectedTracksFeedback (waited on at rate 0, so that the run is repeatable).
 
 #include <climits>
 #include <cstdint>
@@ -22,6 +23,7 @@
 
 #include "messages/tracked_frame.hpp"
 #include "pipeline/latest_value.hpp"
+#include "pipeline/rejected_tracks_feedback.hpp"
 #include "pipeline/publish_item.hpp"
 #include "pipeline/vio/loop_stage.hpp"
 #include "pipeline/vio/frame_imu_attacher.hpp"
@@ -55,6 +57,11 @@ struct TrackerStage {
   /// NavState one, so the estimator publishes the bias a second time, for this stage alone.
   LatestValue<Eigen::Vector3d>& gyro_bias;
   std::function<void(const TrackedFrame&)> on_tracked;  ///< may be empty (VioSinks::tracked)
+  /// The estimator's rejected tracks (rejected_feedback); null: every track counts against max_cnt.
+  RejectedTracksFeedback* rejected = nullptr;
+  /// Wait for the verdict on the frames before that the estimator can finish (TrackerInput::
+  /// finishable_before; rate 0: repeatable); false: take the newest.
+  bool wait_for_verdict = true;
   Eigen::Vector3d bias = Eigen::Vector3d::Zero();  // zero until the estimator tracks
   std::optional<int64_t> prev_t_ns;
   int64_t frames_predicted = 0, frames_unpredicted = 0, features_predicted = 0, features_tracked = 0;
@@ -92,6 +99,8 @@ struct EstimatorStage {
   LatestValue<Eigen::Vector3d>& gyro_bias;  ///< the same state's gyro bias, for the tracker
   int64_t tracking = 0, resets = 0;
   std::function<void(Keyframe&&)> on_keyframe = {};  ///< may be empty (no loop closure): keyframes are dropped
+  RejectedTracksFeedback* rejected = nullptr;  ///< may be null: the tracker is not told
+  int64_t published_done = 0;
 };
 
 /// Writer: hands each estimate to the run's sink and, with `publish`, its status, window pose and weighted
@@ -122,6 +131,7 @@ struct VioStages {
   bool solver_time_budget = true;  ///< the config's max_solver_time applies (paced runs only)
   LatestValue<NavState> latest;
   LatestValue<Eigen::Vector3d> gyro_bias;
+  RejectedTracksFeedback rejected;
   TrackerStage tracker;
   ImuFeedbackStage imu;
   EstimatorStage estimator;

@@ -54,6 +54,11 @@ struct EstimatorOptions {
   bool patch_refine = true;
   /// VINS-Mono's key: contrast-limited histogram equalisation (CLAHE) of every image before tracking.
   bool equalize = false;
+  /// Ours: the tracker learns which tracks the robust BA rejected (weight < 0.5): they stop counting
+  /// against max_cnt, and fresh corners keep clear of the moving objects they form
+  /// (StereoTracker::set_rejected). No effect with the Huber loss, which rejects nothing. Off by default:
+  /// measured in bench/results/seed_sweep.md (stop 44), with one open question.
+  bool rejected_feedback = false;
 
   // Optimization.
   double max_solver_time = 0.04;  ///< seconds

@@ -42,6 +42,7 @@ StereoTracker::StereoTracker(const TrackerOptions& options, CameraModelPtr cam0,
 
 void StereoTracker::reset() {
   tracks_.clear();
+  rejected_.clear();
   prev_pyr_.clear();
 }
 
@@ -226,20 +227,34 @@ void StereoTracker::enforce_spacing_and_detect(const cv::Mat& img, std::vector<T
   mask.create(img.size(), CV_8UC1);
   mask.setTo(255);
   const int radius = static_cast<int>(std::lround(opt_.min_dist));
+  // Tracks the estimator rejected (set_rejected) do not count against max_cnt; one with another rejected
+  // track within kObjectReach min_dist is taken for part of a moving object, whose surface is no place
+  // for a fresh corner: it masks kObjectMask min_dist around it instead of one.
+  constexpr double kObjectReach = 4.0, kObjectMask = 2.0;
+  std::vector<uchar> rejected(tracks.size(), 0), on_object(tracks.size(), 0);
+  for (std::size_t i = 0; i < tracks.size(); ++i)
+    rejected[i] = std::binary_search(rejected_.begin(), rejected_.end(), tracks[i].id);
+  for (std::size_t i = 0; i < tracks.size(); ++i)
+    for (std::size_t j = 0; j < tracks.size() && rejected[i] && !on_object[i]; ++j)
+      on_object[i] = j != i && rejected[j] && distance(tracks[i].px, tracks[j].px) < kObjectReach * opt_.min_dist;
   std::vector<Track> kept;
   std::vector<cv::Point2f> kept_prev;
+  int counted = 0, uncounted = 0;  // against max_cnt, and rejected ones beside it (at most max_cnt)
   for (std::size_t i : order) {
     const cv::Point2f& p = tracks[i].px;
-    if (static_cast<int>(kept.size()) >= opt_.max_cnt || mask.at<uchar>(cvRound(p.y), cvRound(p.x)) == 0) {
+    if ((rejected[i] ? uncounted : counted) >= opt_.max_cnt || mask.at<uchar>(cvRound(p.y), cvRound(p.x)) == 0) {
       ++stats.lost_mask;
       continue;
     }
+    ++(rejected[i] ? uncounted : counted);
     kept.push_back(tracks[i]);
     kept_prev.push_back(prev_px[i]);
-    if (radius > 0) cv::circle(mask, cv::Point(cvRound(p.x), cvRound(p.y)), radius, cv::Scalar(0), cv::FILLED);
+    const int r = on_object[i] ? static_cast<int>(std::lround(kObjectMask * opt_.min_dist)) : radius;
+    if (r > 0) cv::circle(mask, cv::Point(cvRound(p.x), cvRound(p.y)), r, cv::Scalar(0), cv::FILLED);
   }
   stats.tracked = static_cast<int>(kept.size());
-  const int wanted = opt_.max_cnt - static_cast<int>(kept.size());
+  stats.uncounted = uncounted;
+  const int wanted = opt_.max_cnt - counted;
   if (wanted > 0) {
     const std::vector<cv::Point2f> corners =
         detect_corners(img, mask, wanted, opt_.quality_level, opt_.min_dist, &corner_scratch_);
@@ -253,6 +268,11 @@ void StereoTracker::enforce_spacing_and_detect(const cv::Mat& img, std::vector<T
   }
   tracks = std::move(kept);
   prev_px = std::move(kept_prev);
+}
+
+void StereoTracker::set_rejected(std::vector<int64_t> ids) {
+  std::sort(ids.begin(), ids.end());
+  rejected_ = std::move(ids);
 }
 
 void StereoTracker::match_stereo(const Pyramid& curr, const cv::Mat& right_in, std::vector<Track>& tracks,

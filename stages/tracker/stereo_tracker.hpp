@@ -37,6 +37,14 @@ class StereoTracker {
   /// Throws std::invalid_argument on a non-gray or wrongly sized image.
   TrackedFrame process(const StereoFrame& frame, std::optional<Eigen::Matrix3d> R_prev_curr_cam0 = {});
 
+  /// The tracks the estimator has rejected (ids, any order; applies from the next process()). They are
+  /// still tracked and handed on, but do not count against `max_cnt` (at most `max_cnt` of them beside
+  /// it), and one with another rejected track within 4 min_dist (part of a moving object) keeps fresh
+  /// corners 2 min_dist away instead of one: a truck leading the camera otherwise holds half of the
+  /// budget, and the corners born on it are trusted until the weights have seen them move
+  /// (bench/results/seed_sweep.md, stop 44).
+  void set_rejected(std::vector<int64_t> ids);
+
   /// Forgets every track (ids keep increasing).
   void reset();
 
@@ -79,6 +87,7 @@ class StereoTracker {
   cv::Mat right_scaled_, mask_;
   CornerScratch corner_scratch_;
   std::vector<Track> tracks_;
+  std::vector<int64_t> rejected_;  ///< sorted (set_rejected)
   int64_t prev_t_ns_ = 0;
   int64_t next_id_ = 0;
 };

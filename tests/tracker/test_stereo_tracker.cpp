@@ -70,16 +70,17 @@ struct Truth {
 };
 
 struct SimRun {
-  std::vector<TrackedFrame> plain, predicted, ransac, klt_only;
-  std::vector<std::vector<Truth>> truth_plain, truth_predicted, truth_ransac, truth_klt_only;
+  std::vector<TrackedFrame> plain, predicted, ransac, klt_only, fed;
+  std::vector<std::vector<Truth>> truth_plain, truth_predicted, truth_ransac, truth_klt_only, truth_fed;
   std::vector<Eigen::Isometry3d> T_world_cam0;
   sim::StereoRig rig;
   CameraModelPtr cam;
 };
 
 /// 2.5 s along a short avenue; a truck crosses 7 m ahead at t = 1.2 s. Tracked without and with the
-/// gyro prediction (true relative rotation), with F-RANSAC, and without the first-patch refinement
-/// (plain KLT), in one pass over the rendered frames.
+/// gyro prediction (true relative rotation), with F-RANSAC, without the first-patch refinement
+/// (plain KLT), and told after each frame which of its tracks lie on the truck (`fed`, the estimator's
+/// verdict played by the simulator's labels), in one pass over the rendered frames.
 const SimRun& sim_run() {
   static const SimRun kRun = [] {
     const fs::path dir = fs::temp_directory_path() / "dynavins_test_tracker";
@@ -98,7 +99,7 @@ const SimRun& sim_run() {
     with_f.f_ransac = true;
     no_patch.patch_refine = false;
     tracker::StereoTracker plain(tracker::TrackerOptions{}, r.cam, r.cam), predicted(tracker::TrackerOptions{}, r.cam, r.cam),
-        ransac(with_f, r.cam, r.cam), klt_only(no_patch, r.cam, r.cam);
+        ransac(with_f, r.cam, r.cam), klt_only(no_patch, r.cam, r.cam), fed(tracker::TrackerOptions{}, r.cam, r.cam);
     SensorEvent e;
     while (src.next(e)) {
       const auto* f = std::get_if<StereoFrame>(&e);
@@ -112,8 +113,14 @@ const SimRun& sim_run() {
       r.predicted.push_back(predicted.process(*f, R));
       r.ransac.push_back(ransac.process(*f));
       r.klt_only.push_back(klt_only.process(*f));
+      r.fed.push_back(fed.process(*f));
+      std::vector<int64_t> on_truck;
+      for (const auto& ft : r.fed.back().features)
+        if (label_at(f->labels, ft.px) > 0) on_truck.push_back(ft.id);
+      fed.set_rejected(on_truck);
       for (auto [out, truth] : {std::pair{&r.plain, &r.truth_plain}, std::pair{&r.predicted, &r.truth_predicted},
-                                std::pair{&r.ransac, &r.truth_ransac}, std::pair{&r.klt_only, &r.truth_klt_only}}) {
+                                std::pair{&r.ransac, &r.truth_ransac}, std::pair{&r.klt_only, &r.truth_klt_only},
+                                std::pair{&r.fed, &r.truth_fed}}) {
         truth->emplace_back();
         for (const auto& ft : out->back().features)
           truth->back().push_back({true_depth(src.last_left().depth, ft.px), label_at(f->labels, ft.px)});
@@ -312,6 +319,45 @@ TEST_CASE("tracker::StereoTracker: features on the moving truck are tracked and 
   CHECK(o.long_tracks > 10);
   // A few slide off the silhouette (corners on the outline mix truck and background).
   CHECK(o.stayed >= 0.9 * o.later);
+}
+
+TEST_CASE("tracker::StereoTracker: rejected tracks stay beside the budget and keep fresh corners off their object", "[tracker]") {
+  const SimRun& r = sim_run();
+  const tracker::TrackerOptions opt;
+  // Until the truck shows, nothing is rejected and the told tracker is the plain one.
+  std::size_t k = 0;
+  for (; k < r.plain.size() && r.fed[k].stats.uncounted == 0; ++k) {
+    REQUIRE(r.fed[k].features.size() == r.plain[k].features.size());
+    for (std::size_t i = 0; i < r.plain[k].features.size(); ++i) {
+      CHECK(r.fed[k].features[i].id == r.plain[k].features[i].id);
+      CHECK(r.fed[k].features[i].px == r.plain[k].features[i].px);
+    }
+  }
+  REQUIRE(k < r.plain.size());
+  int static_plain = 0, static_fed = 0, born_plain = 0, born_fed = 0, frames_with_truck = 0;
+  for (k = 0; k < r.plain.size(); ++k) {
+    const int uncounted = r.fed[k].stats.uncounted;
+    CHECK(static_cast<int>(r.fed[k].features.size()) <= opt.max_cnt + uncounted);
+    CHECK(uncounted <= opt.max_cnt);
+    int truck = 0;
+    for (const Truth& t : r.truth_plain[k]) truck += t.label > 0;
+    if (truck < 20) continue;  // the truck holds a share of the budget
+    ++frames_with_truck;
+    for (std::size_t i = 0; i < r.plain[k].features.size(); ++i) {
+      static_plain += r.truth_plain[k][i].label == 0;
+      born_plain += r.truth_plain[k][i].label > 0 && r.plain[k].features[i].track_length == 1;
+    }
+    for (std::size_t i = 0; i < r.fed[k].features.size(); ++i) {
+      static_fed += r.truth_fed[k][i].label == 0;
+      born_fed += r.truth_fed[k][i].label > 0 && r.fed[k].features[i].track_length == 1;
+    }
+  }
+  std::printf("while the truck holds >= 20 tracks (%d frames): static tracks %d plain, %d told; corners born on it %d / %d\n",
+              frames_with_truck, static_plain, static_fed, born_plain, born_fed);
+  REQUIRE(frames_with_truck >= 5);
+  // The budget the truck held goes to the static scene, and fewer fresh corners land on the truck.
+  CHECK(static_fed > static_plain + 5 * frames_with_truck);
+  CHECK(born_fed < born_plain);
 }
 
 TEST_CASE("tracker::StereoTracker: the optional F-matrix RANSAC rejects some tracks and keeps static identities", "[tracker]") {

@@ -27,9 +27,10 @@ struct Estimate {
 
 using Driver = VioRunResult (*)(io::SensorSource&, const VioRunOptions&, const VioSinks&, const StopFlag*);
 
-std::vector<Estimate> run_clip(Driver drive, estimator::BaLoss loss, bool stereo) {
+std::vector<Estimate> run_clip(Driver drive, estimator::BaLoss loss, bool stereo, bool rejected_feedback = false) {
   VioRunOptions o;
   o.estimator = EstimatorOptions::load(kConfig);
+  o.estimator.rejected_feedback = rejected_feedback;
   o.mode.loss = loss;
   o.mode.stereo = stereo;
   o.show_progress = false;
@@ -71,6 +72,18 @@ TEST_CASE("sequential and threaded rate-0 runs give the same estimates bit for b
   // Stereo only: the clip stands still, so a mono run never initialises on it (no parallax).
   require_identical(run_clip(&run_vio, estimator::BaLoss::Dynavins, true),
                    run_clip(&run_vio_sequential, estimator::BaLoss::Dynavins, true));
+}
+
+TEST_CASE("with the estimator's rejections fed back to the tracker, threaded and sequential runs still agree",
+          "[vio][sequential]") {
+  // The threaded tracker waits for the verdict on the frames before it (RejectedTracksFeedback); the
+  // sequential one has it at once: the same verdict, so the same tracks and estimates.
+  const auto threaded = run_clip(&run_vio, estimator::BaLoss::Dynavins, true, true);
+  require_identical(threaded, run_clip(&run_vio_sequential, estimator::BaLoss::Dynavins, true, true));
+  int rejected = 0;
+  for (const Estimate& e : threaded)
+    for (const auto& [id, w] : e.weights) rejected += w < 0.5f;
+  CHECK(rejected > 0);  // some verdicts went back (the real clip rejects a few static tracks)
 }
 
 TEST_CASE("run_vio_sequential refuses a paced rate", "[vio][sequential]") {

@@ -166,7 +166,7 @@ TEST_CASE("stereo: a truck that drives off with the camera does not take the est
   const double ratio_with = drive_off_ratio(with), ratio_without = drive_off_ratio(without);
   const eval::WeightScore score = eval::score_weights(with.run.features);
   INFO("path length / true over 1-3 s: " << ratio_with << " with zupt_imu, " << ratio_without
-                                         << " without; moving rejected " << score.moving_rejected);
+                                         << " without; moving rejected " << score.moving_rejected << " of " << score.moving);
   CHECK(with.run.resets == 0);
   CHECK(std::abs(ratio_with - 1.0) < 0.1);
   CHECK(score.moving_rejected >= kMinMovingRejected);
