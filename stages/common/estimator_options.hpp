@@ -57,7 +57,8 @@ struct EstimatorOptions {
   /// Ours: the tracker learns which tracks the robust BA rejected (weight < 0.5): they stop counting
   /// against max_cnt, and fresh corners keep clear of the moving objects they form
   /// (StereoTracker::set_rejected). No effect with the Huber loss, which rejects nothing. Off by default:
-  /// measured in bench/results/seed_sweep.md (stop 44), with one open question.
+  /// measured in bench/results/seed_sweep.md (stop 44); it amplifies a momentary wrong verdict on the
+  /// static scene (a truck driving off with the camera) until a guard exists.
   bool rejected_feedback = false;
 
   // Optimization.
