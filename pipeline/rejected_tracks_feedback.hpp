@@ -26,6 +26,15 @@ class RejectedTracksFeedback {
     changed_.notify_all();
   }
 
+  /// Estimator thread: it has finished `frames_done` frames without a new verdict (skipped ones).
+  void finished(int64_t frames_done) {
+    {
+      std::lock_guard<std::mutex> lock(mutex_);
+      frames_done_ = frames_done;
+    }
+    changed_.notify_all();
+  }
+
   /// Estimator thread, at its end (or failure): no verdict follows, a waiting tracker goes on.
   void close() {
     {

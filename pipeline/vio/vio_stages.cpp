@@ -90,15 +90,14 @@ std::vector<estimator::WindowEstimate> EstimatorStage::process(estimator::Estima
   if (rejected) {
     // Frames received and no longer waiting for their IMU (emitted, skipped or ignored) are finished.
     const int64_t done = pairer.stats().frames_in - static_cast<int64_t>(pairer.waiting_frames());
-    if (!out.empty()) {
+    if (out.empty()) {
+      rejected->finished(done);
+    } else {
       std::vector<int64_t> ids;
       for (const auto& f : out.back().features.features)
         if (f.weight < 0.5f) ids.push_back(f.id);
       rejected->publish(done, std::move(ids));
-    } else if (done != published_done) {
-      rejected->publish(done, rejected->latest());
     }
-    published_done = done;
   }
   return out;
 }

@@ -100,7 +100,6 @@ struct EstimatorStage {
   int64_t tracking = 0, resets = 0;
   std::function<void(Keyframe&&)> on_keyframe = {};  ///< may be empty (no loop closure): keyframes are dropped
   RejectedTracksFeedback* rejected = nullptr;  ///< may be null: the tracker is not told
-  int64_t published_done = 0;
 };
 
 /// Writer: hands each estimate to the run's sink and, with `publish`, its status, window pose and weighted

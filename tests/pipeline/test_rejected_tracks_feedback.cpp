@@ -36,6 +36,10 @@ TEST_CASE("RejectedTracksFeedback: a wait ends at the timeout, and at once after
   std::vector<int64_t> ids;
   CHECK_FALSE(f.wait(4, 20ms, &ids));  // frame 3 not finished: the newest verdict there is
   CHECK(ids == std::vector<int64_t>{7, 9});
+  f.finished(4);  // a frame finished without a new verdict (skipped): the waiter goes on with the last one
+  ids.clear();
+  CHECK(f.wait(4, 0ms, &ids));
+  CHECK(ids == std::vector<int64_t>{7, 9});
   std::thread closer([&] {
     std::this_thread::sleep_for(20ms);
     f.close();
