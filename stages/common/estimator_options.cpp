@@ -29,7 +29,7 @@ const std::vector<OptionSpec>& option_specs() {
       {"flow_back", &O::flow_back, {}, "", "forward-backward check of the temporal KLT"},
       {"patch_refine", &O::patch_refine, {}, "", "align each track's first patch after the KLT (ours); 0 = plain KLT"},
       {"equalize", &O::equalize, {}, "", "VINS-Mono: CLAHE on every image before tracking (dark scenes)"},
-      {"rejected_feedback", &O::rejected_feedback, {}, "", "the tracker learns which tracks the robust BA rejected: they stop counting against max_cnt (up to max_cnt more are tracked), and no corner is detected within 2 min_dist of one with another rejected track within 4 min_dist (ours, issue 23; off: behind a leading truck r_d 1.58 -> 0.88, but as a truck drives off with the camera it amplifies a momentary wrong verdict, README); 0 = every track counts"},
+      {"rejected_feedback", &O::rejected_feedback, {}, "", "the tracker learns which tracks the robust BA rejected: they stop counting against max_cnt (up to max_cnt more are tracked), and no corner is detected within 2 min_dist of one with another rejected track within 4 min_dist (ours, issue 23; behind a leading truck r_d 1.58 -> 0.88; verdicts judged on the IMU path from a rest are not fed back, README); 0 = every track counts"},
       // Optimization.
       {"max_solver_time", &O::max_solver_time, {0, 3600, true}, "s", "Ceres time budget per window solve"},
       {"max_num_iterations", &O::max_num_iterations, {1, 1000}, "", "Ceres iterations per window solve"},

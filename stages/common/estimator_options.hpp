@@ -56,10 +56,11 @@ struct EstimatorOptions {
   bool equalize = false;
   /// Ours: the tracker learns which tracks the robust BA rejected (weight < 0.5): they stop counting
   /// against max_cnt, and fresh corners keep clear of the moving objects they form
-  /// (StereoTracker::set_rejected). No effect with the Huber loss, which rejects nothing. Off by default:
-  /// measured in bench/results/seed_sweep.md (stop 44); it amplifies a momentary wrong verdict on the
-  /// static scene (a truck driving off with the camera) until a guard exists.
-  bool rejected_feedback = false;
+  /// (StereoTracker::set_rejected). No effect with the Huber loss, which rejects nothing. Verdicts judged
+  /// on the IMU path from a rest (zupt_imu) are not fed back: that path drifts, and its wrong verdicts on
+  /// the static scene would steer fresh corners onto a truck that drives off with the camera. Measured in
+  /// bench/results/seed_sweep.md (stops 44-45).
+  bool rejected_feedback = true;
 
   // Optimization.
   double max_solver_time = 0.04;  ///< seconds

@@ -604,6 +604,7 @@ WindowEstimate SlidingWindowEstimator::Impl::process(const TrackedFrame& frame, 
                     frame.t_ns * 1e-9, rest_path.anchor_t_ns() * 1e-9);
     }
     e.solve = optimizer.solve(state, newest, features, judge_on_rest_path ? &rest_path : nullptr);
+    e.judged_on_rest_path = judge_on_rest_path;
     if (!still) {
       imu_still.restart(state.v(newest));
     } else if (opt.zupt_imu && mode.stereo && imu_still.has_biases()) {

@@ -155,6 +155,9 @@ TEST_CASE("stereo: a truck that drives off with the camera does not take the est
   // standstill, and once the solve leaves the IMU's path from the last rest frame the weights are judged
   // on that path. Measured when written: path length / true over the drive-off (1-3 s) 0.975 with it,
   // 0.586 without (bounds: 10 % / the failure still shown); 97.4 % of the moving features rejected.
+  // rejected_feedback (on by default) must not feed back the verdicts judged on that IMU path: they reject
+  // most of the static scene for ~2 s (the path drifts with the accelerometer bias), and fed back they
+  // steered fresh corners onto the truck: 38 of 120 truck tracks ended kept (68 % rejected); 96 % with it.
   const auto drive_off = sim::build_scenario(
       sim::load_scenario(std::string(DYNAVINS_SOURCE_DIR) + "/bench/scenarios/street_follow.yaml"), 26, 6.0);
   const Outcome with = test::run_scene(drive_off, estimator::BaLoss::Dynavins);
