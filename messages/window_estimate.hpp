@@ -37,7 +37,7 @@ struct WindowEstimate {
   bool keyframe = false;        ///< the previous newest frame was kept as a keyframe (VINS' MARGIN_OLD)
   bool standstill = false;      ///< found at rest: its velocity was held at zero (standstill_detector.hpp)
   /// The weights were judged on the IMU-only path from the last rest (zupt_imu, imu_path_from_rest.hpp), a
-  /// path that drifts with the accelerometer bias: a verdict to act on only in this solve.
+  /// path that drifts with the accelerometer bias: verdicts the tracker is not told (rejected_feedback).
   bool judged_on_rest_path = false;
   WeightedFeatureSet features;  ///< window features, weights after this solve (Tracking only)
   SolveStats solve;
