@@ -234,9 +234,11 @@ void StereoTracker::enforce_spacing_and_detect(const cv::Mat& img, std::vector<T
   std::vector<uchar> rejected(tracks.size(), 0), on_object(tracks.size(), 0);
   for (std::size_t i = 0; i < tracks.size(); ++i)
     rejected[i] = std::binary_search(rejected_.begin(), rejected_.end(), tracks[i].id);
-  for (std::size_t i = 0; i < tracks.size(); ++i)
-    for (std::size_t j = 0; j < tracks.size() && rejected[i] && !on_object[i]; ++j)
+  for (std::size_t i = 0; i < tracks.size(); ++i) {
+    if (!rejected[i]) continue;
+    for (std::size_t j = 0; j < tracks.size() && !on_object[i]; ++j)
       on_object[i] = j != i && rejected[j] && distance(tracks[i].px, tracks[j].px) < kObjectReach * opt_.min_dist;
+  }
   std::vector<Track> kept;
   std::vector<cv::Point2f> kept_prev;
   int counted = 0, uncounted = 0;  // against max_cnt, and rejected ones beside it (at most max_cnt)
