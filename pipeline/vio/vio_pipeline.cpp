@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <chrono>
 #include <climits>
+#include <cmath>
 #include <deque>
 #include <memory>
 #include <optional>
@@ -31,6 +32,10 @@ using estimator::WindowEstimate;
 /// false when the run is aborted; `poll` runs before every event (stop requests).
 struct ReplayRouting {
   bool predict = false;
+  /// The config's td [ns] (image clock + td = IMU clock, VINS-Fusion's convention): every frame's time is
+  /// moved into the IMU's clock as it arrives, so the IMU interval of a frame ends when it was taken, and
+  /// every output is in the IMU's clock, where EuRoC's ground truth is.
+  int64_t td_ns = 0;
   std::function<bool(imu::ImuStageInput)> push_imu;
   std::function<bool(TrackerInput)> push_frame;
   std::function<void()> poll;
@@ -56,6 +61,7 @@ struct ReplayRouting {
     ReplaySinks s;
     s.frame = [this](StereoFrame&& f) {
       poll();
+      f.t_ns += td_ns;
       if (!push_imu(imu::FrameTime{f.t_ns})) return false;
       if (!predict) return push_tracked(TrackerInput{std::move(f), {}});
       return push_attached(attacher.add_frame(std::move(f)));
@@ -76,6 +82,8 @@ struct ReplayRouting {
   /// End of the replay: the frame still waiting for its IMU goes on without it.
   void finish() { push_attached(attacher.finish()); }
 };
+
+int64_t td_ns(const EstimatorOptions& o) { return std::llround(o.td * 1e9); }
 
 /// The loop closer's output for the publisher: after an optimisation the keyframe path and each group's
 /// hypotheses; always the newest drift, for the loop-corrected window pose.
@@ -178,6 +186,7 @@ VioRunResult run_vio(io::SensorSource& source, const VioRunOptions& opt, const V
       [&](const StopFlag& stop) {
         ReplayRouting route;
         route.predict = st.predict;
+        route.td_ns = td_ns(opt.estimator);
         route.ground_truth = &result.ground_truth;
         route.poll = [&] {
           if (external_stop && external_stop->stop_requested() && !stop.stop_requested()) {
@@ -273,6 +282,10 @@ VioRunResult run_vio_sequential(io::SensorSource& source, const VioRunOptions& o
   VioRunResult result;
   result.source = source.describe();
   VioStages st(opt, sinks.tracked, sinks.estimate);
+  // One thread: whatever the estimator can finish is finished before the tracker runs, so the tracker
+  // takes the newest verdict. Waiting could only stall, on a frame the IMU pairing still holds (the first
+  // one, when the IMU starts after it): 60 s, then on without it.
+  st.tracker.wait_for_verdict = false;
 
   const char* stage = "replay";  // the stage running now, for the report of a failure
   auto toEstimator = [&](EstimatorInput in) {
@@ -295,6 +308,7 @@ VioRunResult run_vio_sequential(io::SensorSource& source, const VioRunOptions& o
   bool interrupted = false;
   ReplayRouting route;
   route.predict = st.predict;
+  route.td_ns = td_ns(opt.estimator);
   route.ground_truth = &result.ground_truth;
   route.poll = [&] {
     const bool asked = (external_stop && external_stop->stop_requested()) || interrupt_requested();

@@ -48,8 +48,8 @@ const std::vector<OptionSpec>& option_specs() {
       {"acc_w", &O::acc_w, {0, 10, true}, "m/s^3/sqrt(Hz)", "accelerometer bias random walk", true},
       {"gyr_w", &O::gyr_w, {0, 10, true}, "rad/s^2/sqrt(Hz)", "gyroscope bias random walk", true},
       {"g_norm", &O::g_norm, {9.5, 10}, "m/s^2", "gravity magnitude", true},
-      {"estimate_td", &O::estimate_td, {}, "", "estimate the camera-IMU time offset online (read, not used yet)"},
-      {"td", &O::td, {-1, 1}, "s", "time offset: image clock + td = IMU clock (read, not used yet)"},
+      {"estimate_td", &O::estimate_td, {}, "", "VINS-Fusion: estimate td online; not done here (warned): td stays as set"},
+      {"td", &O::td, {-1, 1}, "s", "time offset, image clock + td = IMU clock: frame times are moved by it on input, so outputs are in the IMU clock"},
       // DynaVINS (see estimator_options.hpp for the mapping).
       {"dyna_on", &O::dyna_on, {}, "", "per-feature weights (the authors' switch)"},
       {"regularization_lambda", &O::regularization_gamma, {0, 100}, "", "gamma of the authors' code; lambda_w = gamma^2"},
@@ -270,6 +270,15 @@ EstimatorOptions EstimatorOptions::load(const std::string& path) {
   }
   derive(o);
   o.unknown_keys = find_unknown_keys(r);
+  // VINS-Fusion would calibrate these online; here they stay as the file gives them, which is said once.
+  if (o.estimate_td)
+    spdlog::warn("{}: estimate_td: 1, but the time offset is not estimated online here: td = {} s is applied as set",
+                 path, o.td);
+  if (o.estimate_extrinsic != 0)
+    spdlog::warn("{}: estimate_extrinsic: {}, but the camera-IMU extrinsic is not calibrated online here: body_T_cam{} "
+                 "is used as {}",
+                 path, o.estimate_extrinsic, o.num_of_cam > 1 ? "0/1" : "0",
+                 o.estimate_extrinsic == 2 ? "given (identity where absent)" : "given");
   return o;
 }
 

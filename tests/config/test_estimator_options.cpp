@@ -495,6 +495,28 @@ TEST_CASE("An unknown yaml key is warned, naming it and the file, with the neare
   CHECK(text.find("my_own_setting' (ignored);") == std::string::npos);  // nothing close to it
 }
 
+TEST_CASE("Online calibration asked for (estimate_td, estimate_extrinsic) is warned: it is not done here",
+          "[options]") {
+  ScratchConfig s(kEuroc);
+  std::string path = s.edit("euroc_stereo_imu_config.yaml", "estimate_td: 0", "estimate_td: 1");
+  {
+    LogCapture log;
+    const auto o = EstimatorOptions::load(path);
+    CHECK(o.estimate_td);
+    CHECK_THAT(log.text.str(), Catch::Contains(path) && Catch::Contains("estimate_td: 1") &&
+                                   Catch::Contains("not estimated online"));
+  }
+  path = s.edit("euroc_stereo_imu_config.yaml", "estimate_extrinsic: 0", "estimate_extrinsic: 1");
+  {
+    LogCapture log;
+    EstimatorOptions::load(path);
+    CHECK_THAT(log.text.str(), Catch::Contains(path) && Catch::Contains("not calibrated online"));
+  }
+  LogCapture log;  // VINS-Fusion's own file asks for neither
+  EstimatorOptions::load(kEuroc + "euroc_stereo_imu_config.yaml");
+  CHECK(log.text.str().find("online") == std::string::npos);
+}
+
 TEST_CASE("An unknown --set key names the nearest key and lists the valid ones", "[options][table]") {
   EstimatorOptions o = EstimatorOptions::load(kEuroc + "euroc_stereo_imu_config.yaml");
   CHECK_THROWS_WITH(o.apply("momentum_lamda", "1"),
