@@ -93,6 +93,27 @@ std::vector<GroundTruthState> read_ground_truth(const fs::path& dir) {
   return out;
 }
 
+/// TUM-VI's folders in EuRoC's layout carry motion capture instead: pose only, of the IMU frame.
+std::vector<GroundTruthState> read_mocap(const fs::path& dir) {
+  const std::string csv = (dir / "data.csv").string();
+  std::vector<GroundTruthState> out;
+  int64_t last = INT64_MIN;
+  // timestamp, p_RS_R xyz, q_RS wxyz
+  for (const auto& row : read_csv(csv, 8)) {
+    double v[7];
+    for (int i = 0; i < 7; ++i) v[i] = parse_double(row.fields[1 + i], csv, row.line, "pose value");
+    GroundTruthState gt;
+    gt.t_ns = parse_int64(row.fields[0], csv, row.line, "timestamp");
+    check_increasing(gt.t_ns, last, csv, row.line);
+    gt.p_wb = {v[0], v[1], v[2]};
+    gt.q_wb = Eigen::Quaterniond(v[3], v[4], v[5], v[6]);
+    if (std::abs(gt.q_wb.norm() - 1.0) > 1e-3) throw InputError(csv, row.line, "q_RS is not a unit quaternion");
+    gt.q_wb.normalize();
+    out.push_back(gt);
+  }
+  return out;
+}
+
 cv::Mat read_gray(const std::string& path) {
   cv::Mat img = cv::imread(path, cv::IMREAD_UNCHANGED);
   if (img.empty()) throw InputError(path, 0, "cannot read the image (missing, unreadable or not an image)");
@@ -117,6 +138,8 @@ EurocDataset::EurocDataset(const std::string& dir, int64_t stereo_tolerance_ns) 
   // EuRoC ships the folder with only sensor.yaml for some clips: ground truth only if data.csv exists.
   if (fs::is_regular_file(root / "state_groundtruth_estimate0" / "data.csv"))
     ground_truth_ = read_ground_truth(root / "state_groundtruth_estimate0");
+  else if (fs::is_regular_file(root / "mocap0" / "data.csv"))
+    ground_truth_ = read_mocap(root / "mocap0");
   const fs::path labels_dir = root / "cam0" / "labels";
   const bool has_labels = fs::is_directory(labels_dir);
   auto labels_of = [&](const std::string& image) {

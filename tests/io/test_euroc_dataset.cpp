@@ -67,6 +67,34 @@ TEST_CASE("EurocDataset reads a folder: frames, IMU in EuRoC column order, groun
   CHECK(EurocDataset((root / "mav0").string()).frames().size() == 3);
 }
 
+TEST_CASE("EurocDataset reads TUM-VI's motion capture (mocap0) as ground truth when there is no state estimate",
+          "[euroc]") {
+  const auto add_mocap = [](const fs::path& root) {
+    fs::create_directories(root / "mav0" / "mocap0");
+    std::ofstream(root / "mav0" / "mocap0" / "data.csv")
+        << "#timestamp [ns],p_RS_R_x [m],p_RS_R_y [m],p_RS_R_z [m],q_RS_w [],q_RS_x [],q_RS_y [],q_RS_z []\n"
+        << "1000000000,1,2,3,0,1,0,0\n1010000000,1.5,2,3,0,1,0,0\n";
+  };
+  const auto root = make_folder("tumvi");
+  fs::remove_all(root / "mav0" / "state_groundtruth_estimate0");
+  add_mocap(root);
+  EurocDataset d(root.string());
+  REQUIRE(d.ground_truth().size() == 2);
+  CHECK(d.ground_truth()[1].t_ns == 1'010'000'000);
+  CHECK(d.ground_truth()[1].p_wb == Eigen::Vector3d(1.5, 2, 3));
+  CHECK(d.ground_truth()[1].q_wb.coeffs() == Eigen::Quaterniond(0, 1, 0, 0).coeffs());  // w first, as EuRoC
+  CHECK_FALSE(d.ground_truth()[1].has_velocity);
+  CHECK_FALSE(d.ground_truth()[1].has_biases);
+  // The state estimate wins where both are there (EuRoC's own folders).
+  const auto both = make_folder("both");
+  add_mocap(both);
+  CHECK(EurocDataset(both.string()).ground_truth().size() == 1);
+  // Bad rows name the file and line.
+  append(root / "mav0/mocap0/data.csv", "1020000000,1,2,3,0.5,0.5,0,0\n");
+  CHECK_THROWS_WITH(EurocDataset(root.string()),
+                    Catch::Contains("mocap0/data.csv:4") && Catch::Contains("not a unit quaternion"));
+}
+
 TEST_CASE("EurocSource merges frames, IMU and ground truth in time order, IMU first on ties", "[euroc]") {
   EurocSource src(std::make_shared<EurocDataset>(make_folder("merge").string()));
   SensorEvent e;
