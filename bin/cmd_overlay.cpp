@@ -35,6 +35,7 @@ struct OverlayArgs {
   std::size_t frames = 1;
   double scale = 1.0;
   double min_gap = 2.0;
+  double td = 0.0;  ///< the run's config td: its features.csv times are the recording's + td
 };
 
 // The feature frame nearest to t_ns.
@@ -70,6 +71,7 @@ void run_overlay(const OverlayArgs& a) {
     if (chosen.empty()) throw CommandError("overlay: " + a.features + ": no frame with features", 1);
   }
 
+  const std::int64_t td_ns = std::llround(a.td * 1e9);
   auto source = a.input.open();
   std::map<std::int64_t, cv::Mat> drawn;  // by t_ns
   std::int64_t t0 = 0;
@@ -77,8 +79,9 @@ void run_overlay(const OverlayArgs& a) {
   SensorEvent ev;
   try {
     while (source->next(ev)) {
-      const auto* frame = std::get_if<StereoFrame>(&ev);
+      auto* frame = std::get_if<StereoFrame>(&ev);
       if (frame == nullptr) continue;
+      frame->t_ns += td_ns;  // into the IMU clock, as `run` did (config key td)
       if (!started) {
         started = true;
         t0 = frame->t_ns;
@@ -107,7 +110,9 @@ void run_overlay(const OverlayArgs& a) {
   for (std::size_t i : chosen) {
     if (drawn.count(frames[i].t_ns) == 0)
       throw CommandError("overlay: " + a.features + ": its frame at t_ns " + std::to_string(frames[i].t_ns) +
-                             " is not in " + source->describe() + " (features of another recording?)",
+                             " is not in " + source->describe() +
+                             (a.td == 0.0 ? " (features of another recording, or of a run whose config has a td: pass --td?)"
+                                          : " with --td " + std::to_string(a.td) + " (features of another recording?)"),
                          1);
   }
 
@@ -143,6 +148,9 @@ void add_overlay_command(CLI::App& app) {
   time->excludes(frames);
   sub->add_option("--min-gap", args->min_gap, "minimum time between frames picked by --frames [s]")
       ->check(CLI::Range(0.0, 1e6))
+      ->capture_default_str();
+  sub->add_option("--td", args->td, "the run's config td [s] (image clock + td = IMU clock; features.csv is in the IMU clock)")
+      ->check(CLI::Range(-1.0, 1.0))
       ->capture_default_str();
   sub->add_option("--scale", args->scale, "resize the picture by this factor")
       ->check(CLI::Range(0.05, 4.0))
