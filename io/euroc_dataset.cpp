@@ -69,14 +69,16 @@ std::vector<ImuSample> read_imu(const fs::path& imu_dir) {
   return out;
 }
 
-std::vector<GroundTruthState> read_ground_truth(const fs::path& dir) {
+/// Ground truth: EuRoC's state_groundtruth_estimate0 (timestamp, p_RS_R xyz, q_RS wxyz, v_RS_R xyz, b_w xyz,
+/// b_a xyz) or, `pose_only`, TUM-VI's mocap0 in EuRoC's layout (timestamp, p_RS_R xyz, q_RS wxyz; the IMU's pose).
+std::vector<GroundTruthState> read_ground_truth(const fs::path& dir, bool pose_only) {
   const std::string csv = (dir / "data.csv").string();
+  const int values = pose_only ? 7 : 16;
   std::vector<GroundTruthState> out;
   int64_t last = INT64_MIN;
-  // timestamp, p_RS_R xyz, q_RS wxyz, v_RS_R xyz, b_w xyz, b_a xyz
-  for (const auto& row : read_csv(csv, 17)) {
+  for (const auto& row : read_csv(csv, values + 1)) {
     double v[16];
-    for (int i = 0; i < 16; ++i) v[i] = parse_double(row.fields[1 + i], csv, row.line, "state value");
+    for (int i = 0; i < values; ++i) v[i] = parse_double(row.fields[1 + i], csv, row.line, "state value");
     GroundTruthState gt;
     gt.t_ns = parse_int64(row.fields[0], csv, row.line, "timestamp");
     check_increasing(gt.t_ns, last, csv, row.line);
@@ -84,31 +86,12 @@ std::vector<GroundTruthState> read_ground_truth(const fs::path& dir) {
     gt.q_wb = Eigen::Quaterniond(v[3], v[4], v[5], v[6]);
     if (std::abs(gt.q_wb.norm() - 1.0) > 1e-3) throw InputError(csv, row.line, "q_RS is not a unit quaternion");
     gt.q_wb.normalize();
-    gt.v_wb = {v[7], v[8], v[9]};
-    gt.bias_gyr = {v[10], v[11], v[12]};
-    gt.bias_acc = {v[13], v[14], v[15]};
-    gt.has_velocity = gt.has_biases = true;
-    out.push_back(gt);
-  }
-  return out;
-}
-
-/// TUM-VI's folders in EuRoC's layout carry motion capture instead: pose only, of the IMU frame.
-std::vector<GroundTruthState> read_mocap(const fs::path& dir) {
-  const std::string csv = (dir / "data.csv").string();
-  std::vector<GroundTruthState> out;
-  int64_t last = INT64_MIN;
-  // timestamp, p_RS_R xyz, q_RS wxyz
-  for (const auto& row : read_csv(csv, 8)) {
-    double v[7];
-    for (int i = 0; i < 7; ++i) v[i] = parse_double(row.fields[1 + i], csv, row.line, "pose value");
-    GroundTruthState gt;
-    gt.t_ns = parse_int64(row.fields[0], csv, row.line, "timestamp");
-    check_increasing(gt.t_ns, last, csv, row.line);
-    gt.p_wb = {v[0], v[1], v[2]};
-    gt.q_wb = Eigen::Quaterniond(v[3], v[4], v[5], v[6]);
-    if (std::abs(gt.q_wb.norm() - 1.0) > 1e-3) throw InputError(csv, row.line, "q_RS is not a unit quaternion");
-    gt.q_wb.normalize();
+    if (!pose_only) {
+      gt.v_wb = {v[7], v[8], v[9]};
+      gt.bias_gyr = {v[10], v[11], v[12]};
+      gt.bias_acc = {v[13], v[14], v[15]};
+      gt.has_velocity = gt.has_biases = true;
+    }
     out.push_back(gt);
   }
   return out;
@@ -137,9 +120,9 @@ EurocDataset::EurocDataset(const std::string& dir, int64_t stereo_tolerance_ns) 
   imu_ = read_imu(root / "imu0");
   // EuRoC ships the folder with only sensor.yaml for some clips: ground truth only if data.csv exists.
   if (fs::is_regular_file(root / "state_groundtruth_estimate0" / "data.csv"))
-    ground_truth_ = read_ground_truth(root / "state_groundtruth_estimate0");
+    ground_truth_ = read_ground_truth(root / "state_groundtruth_estimate0", false);
   else if (fs::is_regular_file(root / "mocap0" / "data.csv"))
-    ground_truth_ = read_mocap(root / "mocap0");
+    ground_truth_ = read_ground_truth(root / "mocap0", true);
   const fs::path labels_dir = root / "cam0" / "labels";
   const bool has_labels = fs::is_directory(labels_dir);
   auto labels_of = [&](const std::string& image) {
