@@ -60,6 +60,7 @@ const std::vector<OptionSpec>& option_specs() {
       {"weighted_huber", &O::weighted_huber, {}, "", "Huber loss under the weights (ours); 0 = the paper's eq. 4"},
       {"kept_full_weight", &O::kept_full_weight, {}, "", "1: kept features at full weight in the state step (ours, issue 23; off: mixed result, README); 0 = w_j^2 (eq. 11)"},
       {"residual_per_component", &O::residual_per_component, {}, "", "1: r_j per residual component, in units of the configured noise (ours, issue 23; off: mixed result, README); 0 = per observation"},
+      {"oracle_labels", &O::oracle_labels, {0, 3}, "", "diagnostic, simulated input only: the simulator's labels overrule the state step's weights, 1 static tracks at full weight, 2 moving ones at 0, 3 both (what a perfect verdict would give); 0 = off"},
       {"mono_max_depth_baselines", &O::mono_max_depth_baselines, {0, 1000}, "", "mono: a track deeper than this many times its baseline, while the median depth of the tracks in use is within that, stays out of the state step (ours, issue 23); 0 = off"},
       {"mono_init_wide_window", &O::mono_init_wide_window, {}, "", "mono: after window_size initialisation attempts in a row with the parallax but not the scale, try every other frame of the last 2 window_size + 1 (ours, issue 23)"},
       {"zupt", &O::zupt, {}, "", "zero-velocity update (ours, OpenVINS' keys)"},

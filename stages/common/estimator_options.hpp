@@ -105,6 +105,10 @@ struct EstimatorOptions {
   /// (default) = per observation (a track at the configured noise then has r_j ~ 2 and is rejected);
   /// off by default for the same measured reason as kept_full_weight.
   bool residual_per_component = false;
+  /// Diagnostic for simulated input (0 = off): the simulator's labels overrule the weights in the state
+  /// step (1 static at full weight, 2 moving at 0, 3 both; feature_weights.hpp), to measure how much of an
+  /// error the weights' verdicts cause. Warned when set; no effect where there are no labels.
+  int oracle_labels = 0;
   /// Ours (dynavins, mono only; 0 = off): a track whose best-fit depth is beyond K times the baseline it
   /// was seen over, while the median depth of the tracks in use is within K times that baseline, stays out
   /// of the state step and the prior (its weight stays eq. 10's): its depth is not observable, and a point

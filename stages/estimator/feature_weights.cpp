@@ -25,6 +25,14 @@ double state_step_weight(double w, const FeatureWeightParams& p) {
   return std::min(1.0, w / w_consistent);
 }
 
+double oracle_state_weight(double state_weight, int sim_label, const FeatureWeightParams& p) {
+  const bool static_full = p.oracle_labels == 1 || p.oracle_labels == 3;
+  const bool moving_out = p.oracle_labels == 2 || p.oracle_labels == 3;
+  if (sim_label == 0 && static_full) return 1.0;
+  if (sim_label > 0 && moving_out) return 0.0;
+  return state_weight;
+}
+
 double feature_weight_cost(double w, double r, double w_prev, int n, const FeatureWeightParams& p) {
   const double m = momentum_gain(n, p);
   return w * w * r + p.lambda_w * (1 - w) * (1 - w) + m * (w_prev - w) * (w_prev - w);

@@ -47,6 +47,10 @@ struct FeatureWeightParams {
                                 ///< can still be undone by a long run of consistent residuals
   bool kept_full_weight = false;  ///< state step: ŵ_j = min(1, w_j / w_c) (above); false: ŵ_j = w_j (eq. 11)
   bool residual_per_component = false;  ///< r_j per residual component (above); false: per observation
+  /// Diagnostic, simulated input only (key oracle_labels; 0 = off): the simulator's labels overrule the
+  /// state step's weight, 1 = static tracks at full weight, 2 = moving ones at 0, 3 = both. It measures how
+  /// much of an error the weights' verdicts cause (what a perfect verdict would give); never a setting.
+  int oracle_labels = 0;
 };
 
 /// Closed-form minimiser of eq. (10) over w ∈ [0, 1] for mean whitened squared residual `r`, previous
@@ -55,6 +59,10 @@ double solve_feature_weight(double r, double w_prev, int n, const FeatureWeightP
 
 /// The weight the state step applies to a feature of eq. (10) weight `w` (ŵ_j above).
 double state_step_weight(double w, const FeatureWeightParams& p);
+
+/// The state step's weight of a feature of weight `state_weight` with the simulator's label `sim_label`
+/// (0 static, > 0 a moving object, < 0 unknown) under p.oracle_labels; unknown labels are left alone.
+double oracle_state_weight(double state_weight, int sim_label, const FeatureWeightParams& p);
 
 /// The value of eq. (10) at weight `w` (used by tests and for the converged loss).
 double feature_weight_cost(double w, double r, double w_prev, int n, const FeatureWeightParams& p);

@@ -49,6 +49,7 @@ WindowSolveOptions solve_options(const EstimatorOptions& o, const EstimatorMode&
   s.weighted_huber = o.weighted_huber;
   s.weights.kept_full_weight = o.kept_full_weight;
   s.weights.residual_per_component = o.residual_per_component;
+  s.weights.oracle_labels = o.oracle_labels;
   s.mono_max_depth_baselines = o.mono_max_depth_baselines;
   return s;
 }
@@ -634,7 +635,12 @@ WindowEstimate SlidingWindowEstimator::Impl::process(const TrackedFrame& frame, 
 }
 
 SlidingWindowEstimator::SlidingWindowEstimator(const EstimatorOptions& options, EstimatorMode mode)
-    : impl_(std::make_unique<Impl>(options, mode)) {}
+    : impl_(std::make_unique<Impl>(options, mode)) {
+  if (options.oracle_labels != 0 && mode.loss == BaLoss::Dynavins)
+    spdlog::warn("oracle_labels = {}: a diagnostic, the simulator's labels overrule the weights in the state step "
+                 "(no effect on input without labels); not an estimate to report as the method's",
+                 options.oracle_labels);
+}
 SlidingWindowEstimator::~SlidingWindowEstimator() = default;
 SlidingWindowEstimator::SlidingWindowEstimator(SlidingWindowEstimator&&) noexcept = default;
 SlidingWindowEstimator& SlidingWindowEstimator::operator=(SlidingWindowEstimator&&) noexcept = default;

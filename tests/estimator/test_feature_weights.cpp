@@ -115,3 +115,18 @@ TEST_CASE("r_j is per residual component: a track at exactly the configured nois
   CHECK(feature_residual_scale(sq, p) == Approx(2.0).margin(0.06));
   CHECK(solve_feature_weight(feature_residual_scale(sq, p), 1.0, 0, p) < 0.4);
 }
+
+TEST_CASE("oracle_labels overrules the state step's weight by the simulator's label, only where it knows one") {
+  FeatureWeightParams p;
+  for (int label : {-1, 0, 3}) CHECK(oracle_state_weight(0.3, label, p) == 0.3);  // off: untouched
+  p.oracle_labels = 1;  // static tracks at full weight
+  CHECK(oracle_state_weight(0.3, 0, p) == 1.0);
+  CHECK(oracle_state_weight(0.3, 2, p) == 0.3);
+  p.oracle_labels = 2;  // moving tracks out
+  CHECK(oracle_state_weight(0.3, 0, p) == 0.3);
+  CHECK(oracle_state_weight(0.9, 2, p) == 0.0);
+  p.oracle_labels = 3;  // both
+  CHECK(oracle_state_weight(0.3, 0, p) == 1.0);
+  CHECK(oracle_state_weight(0.9, 7, p) == 0.0);
+  CHECK(oracle_state_weight(0.4, -1, p) == 0.4);  // real input has no labels: the weights decide
+}
