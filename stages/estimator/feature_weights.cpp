@@ -26,10 +26,8 @@ double state_step_weight(double w, const FeatureWeightParams& p) {
 }
 
 double oracle_state_weight(double state_weight, int sim_label, const FeatureWeightParams& p) {
-  const bool static_full = p.oracle_labels == 1 || p.oracle_labels == 3;
-  const bool moving_out = p.oracle_labels == 2 || p.oracle_labels == 3;
-  if (sim_label == 0 && static_full) return 1.0;
-  if (sim_label > 0 && moving_out) return 0.0;
+  if (sim_label == 0 && (p.oracle_labels & 1)) return 1.0;  // bit 1: static tracks at full weight
+  if (sim_label > 0 && (p.oracle_labels & 2)) return 0.0;   // bit 2: moving tracks out
   return state_weight;
 }
 

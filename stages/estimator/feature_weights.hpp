@@ -48,7 +48,7 @@ struct FeatureWeightParams {
   bool kept_full_weight = false;  ///< state step: ŵ_j = min(1, w_j / w_c) (above); false: ŵ_j = w_j (eq. 11)
   bool residual_per_component = false;  ///< r_j per residual component (above); false: per observation
   /// Diagnostic, simulated input only (key oracle_labels; 0 = off): the simulator's labels overrule the
-  /// state step's weight, 1 = static tracks at full weight, 2 = moving ones at 0, 3 = both. It measures how
+  /// state step's weight, bit 1 = static tracks at full weight, bit 2 = moving ones at 0 (3 = both). It measures how
   /// much of an error the weights' verdicts cause (what a perfect verdict would give); never a setting.
   int oracle_labels = 0;
 };

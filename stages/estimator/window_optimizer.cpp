@@ -378,7 +378,7 @@ class WeightStep {
       const bool unobservable =
           judge_depth && depth_unobservable(geometry_, opt_.mono_max_depth_baselines, depth_median);
       f->state_weight = unobservable ? 0.0 : state_step_weight(w, opt_.weights);
-      if (opt_.weights.oracle_labels) f->state_weight = oracle_state_weight(f->state_weight, f->sim_label, opt_.weights);
+      f->state_weight = oracle_state_weight(f->state_weight, f->sim_label, opt_.weights);  // 0 = off: unchanged
     }
     st_.weight_ms += ms_since(t0);
     return features.empty() ? 1.0 : static_cast<double>(settled) / features.size();
