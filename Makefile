@@ -38,7 +38,8 @@ demo: build
 # estimator run on each stereo and mono, Huber and DynaVINS, plus the momentum ablation on `high`;
 # writes bench/results/REPORT.md with its figures and rewrites the README's headline table.
 # About 35-50 min on this 2-core machine with the scenes cached (35 min of runs at fd547cd); on a new
-# machine it renders every scene first: the first 52 of 186 steps took 45 min (stop 46, CI running beside).
+# machine it renders every scene first: 73 min in all at 27297f5 (186 steps, probe runs beside it), where the
+# first 52 steps took 45 min on a slower host (stop 46, CI running beside).
 # bench-quick: `none` and `high` cut to 20 s, a few minutes, report in bench/results/quick/REPORT.md (the README is left alone).
 bench: build
 	DYNAVINS=$(BUILD)/bin/dynavins BENCH_TRACKER=$(BUILD)/bin/bench_tracker ./scripts/bench.sh
