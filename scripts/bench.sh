@@ -6,7 +6,8 @@
 #                             and `high` again at noise seeds 12 to 17 -> bench/results/
 #   quick (make bench-quick): `none` and `high` cut to 20 s (cached as NAME-20s) -> bench/results/quick/
 #   loop-only:                only the loop-closure scenes, DynaVINS BA, their loop-mode runs, mono on
-#                             revisit only, no --loop off run (12 runs) -> bench/results/loop/
+#                             the scenes with genuine revisits only, no --loop off run (18 runs)
+#                             -> bench/results/loop/
 # Loop scenes (loop_scenes below) also run with --loop all and --loop switchable (DynaVINS BA; stereo
 # and mono), beside the plain runs, which are
 # --loop dynavins and whose odometry.tum is --loop off's; and one --loop off run (e_shape stereo) for
@@ -41,7 +42,7 @@ accuracy_scenes=(none high street_none street_crowd_night street_follow)  # at t
 python=${PYTHON:-/usr/bin/python3}
 [ -x "$bin" ] || { echo "bench: $bin not found (make build first)" >&2; exit 1; }
 
-loop_scenes=(temporal_static e_shape revisit)
+loop_scenes=(temporal_static e_shape revisit temporal_revisit)
 bas=(huber dynavins)
 if [ "$quick" = 1 ]; then
   scenarios=(none high)
@@ -50,14 +51,14 @@ if [ "$quick" = 1 ]; then
   out=${out:-bench/results/quick}
   extra_seeds=()
 elif [ "$quick" = 2 ]; then
-  scenarios=(e_shape revisit temporal_static)
+  scenarios=(e_shape revisit temporal_static temporal_revisit)
   bas=(dynavins)  # the loop table compares loop modes over the DynaVINS odometry
   sim_args=()
   suffix=""
   out=${out:-bench/results/loop}
   extra_seeds=()
 else
-  scenarios=(none low mid high night mav_none mav_high standstill_none standstill_high dynamic_follow temporal_static e_shape revisit
+  scenarios=(none low mid high night mav_none mav_high standstill_none standstill_high dynamic_follow temporal_static e_shape revisit temporal_revisit
              street_none street_crowd street_crowd_night street_jam street_follow_none street_follow
              street_turns_none street_turns)
   sim_args=()
@@ -97,9 +98,10 @@ printf 'kind\tscenario\tmode\tba\tvariant\tstatus\twall_s\tdir\tcommand\n' > "$m
 # --- progress ---------------------------------------------------------------------------------
 runs_per_scene=$((2 * ${#bas[@]}))
 loop_sensors=(stereo mono)
-# --loop-only keeps to the runs the loop table needs most: mono (odometry that drifts) on revisit only
+# --loop-only keeps to the runs the loop table needs most: mono (odometry that drifts) only where
+# there are genuine revisits to correct it
 loop_sensors_of() {
-  if [ "$quick" = 2 ] && [ "$1" != revisit ]; then echo stereo; else echo "${loop_sensors[@]}"; fi
+  if [ "$quick" = 2 ] && [ "$1" != revisit ] && [ "$1" != temporal_revisit ]; then echo stereo; else echo "${loop_sensors[@]}"; fi
 }
 is_loop_scene() { local s; for s in "${loop_scenes[@]}"; do [ "$s" = "$1" ] && return 0; done; return 1; }
 n_loop=0
