@@ -44,6 +44,7 @@ DEGRADATION_PAIRS = [MAIN_PAIRS[0], ("low", "none"), ("mid", "none"), ("night", 
 # compares the loop modes' trajectory.tum. LOOP_SCENES run with --loop all / switchable too (scripts/bench.sh).
 ODOMETRY_ONLY = {"dynamic_follow", "temporal_static", "e_shape", "revisit", "temporal_revisit"}
 LOOP_SCENES = ["temporal_static", "e_shape", "revisit", "temporal_revisit"]
+LOOP_EDGE_FIGURES = [("e_shape", "loop_edges.png"), ("temporal_revisit", "loop_edges_temporal_revisit.png")]
 LOOP_MODES = [("off", "", "ate_se3_m"), ("all", "loopall", "trajectory_ate_se3_m"),
               ("switchable", "loopswitchable", "trajectory_ate_se3_m"), ("dynavins", "", "trajectory_ate_se3_m")]
 MODES = [("mono", "M-I"), ("stereo", "S-I")]
@@ -933,17 +934,23 @@ def write_report(results_dir, meta, manifest, runs, figures):
         L += ["Loop stage time per keyframe (`--loop dynavins` runs; its own thread, rate 0), its parts, and memory "
               "of the keyframe database per keyframe (descriptors and points, no images):", ""]
         L += loop_speed_lines(runs) + [""]
-        if "loop_edges" in figures:
-            L += [f"![verified loops on e_shape]({figures['loop_edges']})", "",
-                  "*`e_shape`, stereo, `--loop dynavins`: `trajectory.tum` (black) on the ground truth (grey), every "
-                  "verified loop drawn between its two keyframes, green when its final weight is >= 0.5, red when "
-                  "rejected (the paper's Fig. 8(b)).*", ""]
+        for scene, _ in LOOP_EDGE_FIGURES:
+            if "loop_edges:" + scene in figures:
+                L += [f"![verified loops on {scene}]({figures['loop_edges:' + scene]})", "",
+                      f"*`{scene}`, stereo, `--loop dynavins`: `trajectory.tum` (black) on the ground truth (grey), "
+                      "every verified loop drawn between its two keyframes, green when its final weight is >= 0.5, "
+                      "red when rejected (the paper's Fig. 8(b)).*", ""]
         L += ["Pose-graph solve time as the graph grows: `build/bin/bench_pose_graph` (synthetic graphs, "
               "see the README's Loop closure section).", ""]
     else:
         L += ["No loop-closure scene in this run set.", ""]
-    L += ["## Live LCM interface", "", "LCM interface: not implemented yet (issue pending). This section will hold "
-          "latency and throughput over LCM.", ""]
+    # The LCM figures need udpm inside a private network namespace, so they are measured apart.
+    lcm_md = os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "results", "lcm.md")
+    L += ["## Live LCM interface", "",
+          "Measured apart, since it needs udpm in a private network namespace: `bench/lcm_bench.sh` (what "
+          "publishing costs at rate 0, input-to-pose latency, `live` at 1x fed by lcm-logplayer) writes "
+          + (f"[`bench/results/lcm.md`]({os.path.relpath(lcm_md, results_dir)})." if os.path.isfile(lcm_md)
+             else "`bench/results/lcm.md` (not run yet here)."), ""]
 
     L += ["## How to regenerate", "",
           "`make bench` (full) or `make bench-quick`; the exact commands of this report:", ""]
@@ -977,10 +984,11 @@ def main():
     figures = {}
     plot_trajectories(runs, scenarios, os.path.join(args.results, "trajectories.png"))
     plot_ate_bars(runs, scenarios, os.path.join(args.results, "ate_bars.png"))
-    loop_run = runs.get(("e_shape", "stereo", "dynavins", ""))
-    if loop_run is not None and loop_run.status != "error" and plot_loop_edges(
-            loop_run, os.path.join(args.results, "loop_edges.png")):
-        figures["loop_edges"] = "loop_edges.png"
+    for scene, png in LOOP_EDGE_FIGURES:
+        loop_run = runs.get((scene, "stereo", "dynavins", ""))
+        if loop_run is not None and loop_run.status != "error" and plot_loop_edges(
+                loop_run, os.path.join(args.results, png)):
+            figures["loop_edges:" + scene] = png
     overlay = [e for e in manifest if e["kind"] == "overlay" and e["status"] == "ok"]
     if overlay and os.path.isfile(os.path.join(args.results, os.path.basename(overlay[0]["dir"]))):
         figures["overlay"] = os.path.basename(overlay[0]["dir"])
