@@ -170,7 +170,7 @@ TEST_CASE("The street family: every traffic scene is its static twin's drive", "
   }
 }
 
-TEST_CASE("The loop scenes move their truck while the camera looks away from both places", "[scenario][files]") {
+TEST_CASE("The loop scenes move their truck unseen: the camera faces away from where it stood", "[scenario][files]") {
   // A temporarily static object (paper IV) must be moved unseen: at each relocation the camera faces
   // away from where the truck stood, and where it goes is behind the camera or over 40 m ahead.
   const StereoRig rig = StereoRig::standard();
@@ -197,7 +197,8 @@ TEST_CASE("The loop scenes move their truck while the camera looks away from bot
 }
 
 TEST_CASE("`temporal_revisit` drives its first stretch a second time, the same way", "[scenario][files]") {
-  // Its genuine loops: the last ~18 s but their final stop retrace poses of the first leg (position and viewing direction).
+  // Its genuine loops: from 18 s to 4 s before the end (the final stop left out) the camera retraces poses
+  // of the first leg, in position and viewing direction.
   const StereoRig rig = StereoRig::standard();
   const auto spec = load_scenario((kScenarios / "temporal_revisit.yaml").string());
   const auto body = build_body_trajectory(spec);
