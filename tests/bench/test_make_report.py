@@ -161,6 +161,9 @@ def main():
         check("| `e_shape` | S-I | 100 | 12.0 | 30.0 | 50.0 | 9.0 | 4.0 | 1.0 | 5.0 | 20.0 | 2 | 25.0 |" in report,
               "loop timing per keyframe (wall and the loop thread's CPU) and memory per keyframe (2500 kB / 100)")
         check(os.path.isfile(os.path.join(results, "loop_edges.png")), "loop_edges.png written")
+        check("![verified loops on e_shape](loop_edges.png)" in report, "the loop-edge figure is in the report")
+        check("not implemented" not in report and "`bench/lcm_bench.sh`" in report,
+              "the LCM section says where the LCM figures are measured")
         check(os.path.isfile(os.path.join(results, "ate_bars.png")), "ate_bars.png written")
         check(os.path.isfile(os.path.join(results, "trajectories.png")), "trajectories.png written")
         text = open(readme).read()
