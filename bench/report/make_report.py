@@ -934,12 +934,11 @@ def write_report(results_dir, meta, manifest, runs, figures):
         L += ["Loop stage time per keyframe (`--loop dynavins` runs; its own thread, rate 0), its parts, and memory "
               "of the keyframe database per keyframe (descriptors and points, no images):", ""]
         L += loop_speed_lines(runs) + [""]
-        for scene, _ in LOOP_EDGE_FIGURES:
-            if "loop_edges:" + scene in figures:
-                L += [f"![verified loops on {scene}]({figures['loop_edges:' + scene]})", "",
-                      f"*`{scene}`, stereo, `--loop dynavins`: `trajectory.tum` (black) on the ground truth (grey), "
-                      "every verified loop drawn between its two keyframes, green when its final weight is >= 0.5, "
-                      "red when rejected (the paper's Fig. 8(b)).*", ""]
+        for scene, png in figures.get("loop_edges", []):
+            L += [f"![verified loops on {scene}]({png})", "",
+                  f"*`{scene}`, stereo, `--loop dynavins`: `trajectory.tum` (black) on the ground truth (grey), "
+                  "every verified loop drawn between its two keyframes, green when its final weight is >= 0.5, "
+                  "red when rejected (the paper's Fig. 8(b)).*", ""]
         L += ["Pose-graph solve time as the graph grows: `build/bin/bench_pose_graph` (synthetic graphs, "
               "see the README's Loop closure section).", ""]
     else:
@@ -988,7 +987,7 @@ def main():
         loop_run = runs.get((scene, "stereo", "dynavins", ""))
         if loop_run is not None and loop_run.status != "error" and plot_loop_edges(
                 loop_run, os.path.join(args.results, png)):
-            figures["loop_edges:" + scene] = png
+            figures.setdefault("loop_edges", []).append((scene, png))
     overlay = [e for e in manifest if e["kind"] == "overlay" and e["status"] == "ok"]
     if overlay and os.path.isfile(os.path.join(args.results, os.path.basename(overlay[0]["dir"]))):
         figures["overlay"] = os.path.basename(overlay[0]["dir"])

@@ -34,6 +34,11 @@ std::vector<double> moving_share(const std::string& name, double start, double s
   return share;
 }
 
+/// cam0's viewing direction in the world at time t (the standard rig on the body path).
+Eigen::Vector3d camera_forward(const SmoothTrajectory& body, double t) {
+  return body.rotation(t) * StereoRig::standard().T_body_cam0.linear().col(2);
+}
+
 }  // namespace
 
 TEST_CASE("Every scenario file loads and its path builds", "[scenario][files]") {
@@ -173,7 +178,6 @@ TEST_CASE("The street family: every traffic scene is its static twin's drive", "
 TEST_CASE("The loop scenes move their truck unseen: the camera faces away from where it stood", "[scenario][files]") {
   // A temporarily static object (paper IV) must be moved unseen: at each relocation the camera faces
   // away from where the truck stood, and where it goes is behind the camera or over 40 m ahead.
-  const StereoRig rig = StereoRig::standard();
   for (const char* name : {"temporal_static", "e_shape", "temporal_revisit"}) {
     const auto spec = load_scenario((kScenarios / (std::string(name) + ".yaml")).string());
     const auto body = build_body_trajectory(spec);
@@ -182,7 +186,7 @@ TEST_CASE("The loop scenes move their truck unseen: the camera faces away from w
       if (o.motion != ObjectMotion::Relocate) continue;
       for (std::size_t i = 1; i < o.poses.size(); ++i) {
         const double t = o.poses[i][0];
-        const Eigen::Vector3d forward = body->rotation(t) * rig.T_body_cam0.linear().col(2);
+        const Eigen::Vector3d forward = camera_forward(*body, t);
         const auto to = [&](const Eigen::Vector4d& place) {
           return Eigen::Vector3d(place[1] - body->position(t).x(), place[2] - body->position(t).y(), 0.0);
         };
@@ -199,16 +203,14 @@ TEST_CASE("The loop scenes move their truck unseen: the camera faces away from w
 TEST_CASE("`temporal_revisit` drives its first stretch a second time, the same way", "[scenario][files]") {
   // Its genuine loops: from 18 s to 4 s before the end (the final stop left out) the camera retraces poses
   // of the first leg, in position and viewing direction.
-  const StereoRig rig = StereoRig::standard();
   const auto spec = load_scenario((kScenarios / "temporal_revisit.yaml").string());
   const auto body = build_body_trajectory(spec);
   const double end = body->duration();
-  const auto forward = [&](double t) { return Eigen::Vector3d(body->rotation(t) * rig.T_body_cam0.linear().col(2)); };
   for (double t = end - 18.0; t <= end - 4.0; t += 1.0) {
     double best = 1e9, angle = 0.0;
     for (double s = 0.0; s <= 22.0; s += 0.05) {
       const double d = (body->position(t) - body->position(s)).norm();
-      if (d < best) best = d, angle = std::acos(std::clamp(forward(t).dot(forward(s)), -1.0, 1.0));
+      if (d < best) best = d, angle = std::acos(std::clamp(camera_forward(*body, t).dot(camera_forward(*body, s)), -1.0, 1.0));
     }
     INFO("t = " << t << " s: nearest first-pass pose " << best << " m away, " << angle * 180.0 / M_PI << " deg");
     CHECK(best < 0.3);
