@@ -60,7 +60,7 @@ TEST_CASE("KeyframeGrouper: a feature must be tracked through every keyframe, no
   CHECK(closed->t_ns == std::vector<int64_t>{0, 1, 2});
 }
 
-TEST_CASE("KeyframeGrouper: the size cap closes a group, and groups under min_group_size are dropped",
+TEST_CASE("KeyframeGrouper: the size cap closes a group, groups under min_group_size are dropped, the last one kept",
           "[loop][grouper]") {
   KeyframeGrouper g;  // defaults: alpha 25, at most 20 keyframes, groups under 8 dropped
   const std::vector<int64_t> same = id_range(0, 100);
@@ -72,8 +72,22 @@ TEST_CASE("KeyframeGrouper: the size cap closes a group, and groups under min_gr
   CHECK(g.groups()[0].t_ns.size() == 20);
   CHECK(g.groups()[0].first_t_ns() == 0);
   CHECK(g.groups()[1].first_t_ns() == 20);
-  CHECK_FALSE(g.finish());  // the last 5 keyframes: under 8, dropped
-  CHECK(g.num_dropped() == 1);
+  // finish(): the last 5 keyframes, under 8, are kept (keep_last_group) ...
+  KeyframeGrouper kept = g;
+  const auto last = kept.finish();
+  REQUIRE(last);
+  CHECK(last->first_t_ns() == 40);
+  CHECK(last->t_ns.size() == 5);
+  CHECK(kept.groups().size() == 3);
+  CHECK(kept.num_dropped() == 0);
+  // ... or dropped like any other short group (the paper).
+  KeyframeGrouperOptions paper;
+  paper.keep_last_group = false;
+  KeyframeGrouper strict(paper);
+  for (int k = 0; k < 45; ++k) strict.add_keyframe(k, same);
+  CHECK_FALSE(strict.finish());
+  CHECK(strict.groups().size() == 2);
+  CHECK(strict.num_dropped() == 1);
 
   // A keyframe with no shared features between two long runs: a group of one, dropped.
   KeyframeGrouper h;

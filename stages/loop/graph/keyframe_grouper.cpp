@@ -38,22 +38,22 @@ std::optional<KeyframeGroup> KeyframeGrouper::add_keyframe(int64_t t_ns, const s
       return std::nullopt;
     }
   }
-  std::optional<KeyframeGroup> closed = close_open_group();
+  std::optional<KeyframeGroup> closed = close_open_group(options_.min_group_size);
   open_.t_ns.assign(1, t_ns);  // C_k starts the next group: F_k^k = ids(C_k)
   shared_ = std::move(ids);
   return closed;
 }
 
 std::optional<KeyframeGroup> KeyframeGrouper::finish() {
-  std::optional<KeyframeGroup> closed = close_open_group();
+  std::optional<KeyframeGroup> closed = close_open_group(options_.keep_last_group ? 1 : options_.min_group_size);
   open_.t_ns.clear();
   shared_.clear();
   return closed;
 }
 
-std::optional<KeyframeGroup> KeyframeGrouper::close_open_group() {
+std::optional<KeyframeGroup> KeyframeGrouper::close_open_group(int min_size) {
   if (open_.t_ns.empty()) return std::nullopt;
-  if (static_cast<int>(open_.t_ns.size()) < options_.min_group_size) {
+  if (static_cast<int>(open_.t_ns.size()) < min_size) {
     ++num_dropped_;
     return std::nullopt;
   }

@@ -15,6 +15,11 @@ struct KeyframeGrouperOptions {
   int min_shared_features = 25;  ///< alpha of eq. 12 (DESIGN.md §1)
   int max_group_size = 20;       ///< a group closes after this many keyframes
   int min_group_size = 8;        ///< closed groups with fewer keyframes are dropped (not used for loops)
+  /// Ours, not in the paper: finish() keeps the group still open at the end of the run whatever its size.
+  /// The end cut it short, not a loss of tracks (what min_group_size guards against), and its loops are
+  /// the only ones that correct the run's last keyframes: on `revisit` (stereo) the twelve true loops of
+  /// its last, short group took the loop-corrected ATE from 0.080 to 0.062 m.
+  bool keep_last_group = true;
 };
 
 /// One group G_i: its keyframes in time order; t_ns.front() is C_i.
@@ -36,7 +41,7 @@ class KeyframeGrouper {
   /// this closed, if it closed one that is kept (>= min_group_size keyframes).
   std::optional<KeyframeGroup> add_keyframe(int64_t t_ns, const std::vector<int64_t>& feature_ids);
 
-  /// Closes the open group (end of the run). Returns it if it is kept.
+  /// Closes the open group (end of the run). Returns it if it is kept (keep_last_group: if it is not empty).
   std::optional<KeyframeGroup> finish();
 
   /// All kept groups closed so far, in time order.
@@ -48,7 +53,7 @@ class KeyframeGrouper {
   int num_dropped() const { return num_dropped_; }
 
  private:
-  std::optional<KeyframeGroup> close_open_group();
+  std::optional<KeyframeGroup> close_open_group(int min_size);  // dropped (nullopt) under min_size keyframes
 
   KeyframeGrouperOptions options_;
   KeyframeGroup open_;
