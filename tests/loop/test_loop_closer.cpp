@@ -224,7 +224,8 @@ double lap2_recall(const LoopScenario& s, const std::vector<VerifiedLoop>& loops
 
 TEST_CASE("LoopCloser: true revisits are detected and verified", "[loop][closer]") {
   const World w = make_world();
-  const Run r = run(w, train_vocabulary(w), LoopMode::Dynavins);
+  const auto vocab = train_vocabulary(w);
+  const Run r = run(w, vocab, LoopMode::Dynavins);
   // Every verified loop joins a lap-2 query to a lap-1 match with the true relative pose.
   REQUIRE(r.loops.size() >= 100);
   double worst = 0.0;
@@ -249,7 +250,7 @@ TEST_CASE("LoopCloser: true revisits are detected and verified", "[loop][closer]
   CHECK(r.result.groups.size() == 5);  // lap-2 groups with loops
   LoopCloserOptions paper;
   paper.grouping.keep_last_group = false;
-  const Run dropped = run(w, train_vocabulary(w), LoopMode::Dynavins, paper);
+  const Run dropped = run(w, vocab, LoopMode::Dynavins, paper);
   CHECK(dropped.result.groups.size() == 4);
   std::size_t grouped = 0;
   for (const LoopResult& l : dropped.result.loops) grouped += l.group >= 0 ? 1 : 0;

@@ -208,9 +208,10 @@ TEST_CASE("`temporal_revisit` drives its first stretch a second time, the same w
   const double end = body->duration();
   for (double t = end - 18.0; t <= end - 4.0; t += 1.0) {
     double best = 1e9, angle = 0.0;
+    const Eigen::Vector3d forward = camera_forward(*body, t);
     for (double s = 0.0; s <= 22.0; s += 0.05) {
       const double d = (body->position(t) - body->position(s)).norm();
-      if (d < best) best = d, angle = std::acos(std::clamp(camera_forward(*body, t).dot(camera_forward(*body, s)), -1.0, 1.0));
+      if (d < best) best = d, angle = std::acos(std::clamp(forward.dot(camera_forward(*body, s)), -1.0, 1.0));
     }
     INFO("t = " << t << " s: nearest first-pass pose " << best << " m away, " << angle * 180.0 / M_PI << " deg");
     CHECK(best < 0.3);
