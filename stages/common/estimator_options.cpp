@@ -62,7 +62,7 @@ const std::vector<OptionSpec>& option_specs() {
       {"residual_per_component", &O::residual_per_component, {}, "", "1: r_j per residual component, in units of the configured noise (ours, issue 23; off: mixed result, README); 0 = per observation"},
       {"oracle_labels", &O::oracle_labels, {0, 3}, "", "diagnostic, simulated input only: the simulator's labels overrule the state step's weights, 1 static tracks at full weight, 2 moving ones at 0, 3 both (what a perfect verdict would give); 0 = off"},
       {"mono_max_depth_baselines", &O::mono_max_depth_baselines, {0, 1000}, "", "mono: a track deeper than this many times its baseline, while the median depth of the tracks in use is within that, stays out of the state step (ours, issue 23); 0 = off"},
-      {"mono_init_wide_window", &O::mono_init_wide_window, {}, "", "mono: after window_size initialisation attempts in a row with the parallax but not the scale, try every other frame of the last 2 window_size + 1 (ours, issue 23)"},
+      {"mono_init_wide_window", &O::mono_init_wide_window, {}, "", "mono: one frame in 2, 3 or 4 of the last 4 window_size + 1 is tried too, in the same slots; the window starts from the one whose scale is most certain, when the latest window_size + 1 pass, or alone after window_size attempts in a row with the parallax but not the scale (ours, issue 23); 0: the latest window_size + 1 only"},
       {"zupt", &O::zupt, {}, "", "zero-velocity update (ours, OpenVINS' keys)"},
       {"zupt_max_velocity", &O::zupt_max_velocity, {0, 10}, "m/s", "at rest only below this speed of the last solve"},
       {"zupt_max_disparity", &O::zupt_max_disparity, {0, 50}, "px", "at rest only below this median rotation-compensated motion"},

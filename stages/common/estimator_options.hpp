@@ -115,10 +115,12 @@ struct EstimatorOptions {
   /// moving with the camera looks exactly like it (window_optimizer.cpp, depth_unobservable; README,
   /// "Street scenes"). 30 = a parallax of 1.9 deg.
   double mono_max_depth_baselines = 30.0;
-  /// Ours (mono): when window_size attempts in a row had the parallax but not the scale (the SfM worked,
-  /// the visual-inertial alignment did not), try every other frame of the last 2 window_size + 1 (twice
-  /// the time, the same slots) before dropping the oldest: a start from rest can reach the parallax late
-  /// in its acceleration, and the scale then misses it for good (README, "Street scenes").
+  /// Ours (mono): besides the latest window_size + 1 frames, one frame in 2, 3 or 4 of the last
+  /// 4 window_size + 1 (the same slots over 2-4 times the time). When the latest frames initialise, the
+  /// window starts from whichever candidate's scale is most certain; when window_size attempts in a row had
+  /// the parallax but not the scale, the longer spans are tried alone. A start from rest reaches the
+  /// parallax late in its acceleration, where the latest frames see it nearly constant and their scale is
+  /// poor or missing (README, "Street scenes").
   bool mono_init_wide_window = true;
   /// Ours, not the paper's: zero-velocity update (standstill_detector.hpp), with OpenVINS' key names and
   /// defaults. A frame whose kept features show less than `zupt_max_disparity` px of rotation-compensated

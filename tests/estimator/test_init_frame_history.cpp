@@ -103,6 +103,14 @@ TEST_CASE("the history keeps the latest frames and strides back from the newest"
   REQUIRE(s3.size() == 2);
   CHECK(s3[0].frame.seq == 4);
   CHECK(s3[1].frame.seq == 7);
+  // At most max_frames, counted back from the newest.
+  const std::vector<HistoryFrame> s2 = h.strided(2, 2);
+  REQUIRE(s2.size() == 2);
+  CHECK(s2[0].frame.seq == 5);
+  CHECK(s2[1].frame.seq == 7);
+  CHECK(h.strided(1, 1).size() == 1);
+  CHECK(h.strided(1, 9).size() == 5);
+  CHECK_THROWS(h.strided(1, -1));
 
   h.clear();
   CHECK(h.size() == 0);

@@ -38,13 +38,14 @@ void InitFrameHistory::push(const TrackedFrame& frame, const PreintegratedInterv
   while (size() > capacity_) frames_.pop_front();
 }
 
-std::vector<HistoryFrame> InitFrameHistory::strided(int stride) const {
+std::vector<HistoryFrame> InitFrameHistory::strided(int stride, int max_frames) const {
   if (stride < 1) throw std::invalid_argument("InitFrameHistory::strided: stride must be at least 1");
+  if (max_frames < 0) throw std::invalid_argument("InitFrameHistory::strided: max_frames must not be negative");
   std::vector<HistoryFrame> out;
   if (frames_.empty()) return out;
   const int newest = size() - 1;
   int first = newest;
-  while (first - stride >= 0) first -= stride;
+  for (int n = 1; first - stride >= 0 && (max_frames == 0 || n < max_frames); ++n) first -= stride;
   for (int i = first; i <= newest; i += stride) {
     HistoryFrame h;
     h.frame = frames_[i].frame;

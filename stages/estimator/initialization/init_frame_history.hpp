@@ -1,7 +1,7 @@
 #pragma once
-// The frames before a mono initialisation, kept for twice the window: when the latest W+1 frames cannot
-// initialise (parallax or scale), every other frame of the last 2W+1 spans twice the time in the same W+1
-// slots (ours, issue 23: a start from rest reaches parallax late, when its acceleration is nearly over).
+// The frames before a mono initialisation, kept for several window lengths: every 2nd, 3rd or 4th frame of
+// them spans 2-4 times the time of the latest W+1 frames in the same W+1 slots (ours, issue 23: a start
+// from rest reaches parallax late, when its acceleration is nearly over).
 
 #include <deque>
 #include <optional>
@@ -34,9 +34,9 @@ class InitFrameHistory {
   int size() const { return static_cast<int>(frames_.size()); }
   bool full() const { return size() == capacity_; }
 
-  /// The newest frame and every `stride`-th one before it, oldest first; each one's interval joined over
-  /// the frames skipped, the first one's left empty.
-  std::vector<HistoryFrame> strided(int stride) const;
+  /// The newest frame and every `stride`-th one before it, at most `max_frames` in all (0: no limit),
+  /// oldest first; each one's interval joined over the frames skipped, the first one's left empty.
+  std::vector<HistoryFrame> strided(int stride, int max_frames = 0) const;
 
  private:
   int capacity_;
