@@ -115,6 +115,12 @@ struct EstimatorOptions {
   /// moving with the camera looks exactly like it (window_optimizer.cpp, depth_unobservable; README,
   /// "Street scenes"). 30 = a parallax of 1.9 deg.
   double mono_max_depth_baselines = 30.0;
+  /// Ours (dynavins, mono only; 0 = off): each track keeps its observations in up to this many keyframes
+  /// after they leave the window, with their estimated poses; a track that, over those and the window
+  /// together, does not fit one static point (r_j beyond λw) stays out of the state step and the prior.
+  /// A point riding with the camera a few metres ahead fits a static one within a window, not over the
+  /// distance before it (window_optimizer.cpp, history_inconsistent; README, "Street scenes").
+  int mono_history_keyframes = 16;
   /// Ours (mono): besides the latest window_size + 1 frames, one frame in 2, 3 or 4 of the last
   /// 4 window_size + 1 (the same slots over 2-4 times the time). When the latest frames initialise, the
   /// window starts from whichever candidate's scale is most certain; when window_size attempts in a row had

@@ -85,6 +85,8 @@ struct SlidingWindowEstimator::Impl {
     }
     if (o.body_T_cam.size() < 2) state.extrinsic[1] = state.extrinsic[0];
     T_c0c1 = extrinsic_of(state.extrinsic[0]).inverse() * extrinsic_of(state.extrinsic[1]);
+    // The mono weight step reads the tracks' past (window_optimizer.cpp, history_inconsistent).
+    if (!m.stereo && m.loss == BaLoss::Dynavins) features.set_max_past(o.mono_history_keyframes);
   }
 
   WindowEstimate process(const TrackedFrame& frame, const PreintegratedInterval* imu);
@@ -432,7 +434,7 @@ std::string SlidingWindowEstimator::Impl::failure_reason(const Eigen::Vector3d& 
 void SlidingWindowEstimator::Impl::slide(bool keep_second_newest) {
   if (keep_second_newest) {
     if (tracking) optimizer.marginalize_oldest(state, newest, features);
-    features.remove_oldest(cams());
+    features.remove_oldest(cams(), tracking);  // before the initialisation the poses mean nothing
     for (int k = 0; k < newest; ++k) {
       state.move_slot(k + 1, k);
       slot_seq[k] = slot_seq[k + 1];

@@ -101,8 +101,10 @@ void WindowFeatures::reanchor(WindowFeature& f, const CameraPose& old_anchor, co
   }
 }
 
-void WindowFeatures::remove_oldest(const SlotCameraPose& cam) {
+void WindowFeatures::remove_oldest(const SlotCameraPose& cam, bool keep_past) {
   const CameraPose c0 = cam(0), c1 = cam(1);
+  keep_past = keep_past && max_past_ > 0;
+  if (keep_past) past_frame_ = c1;
   for (auto it = features_.begin(); it != features_.end();) {
     WindowFeature& f = it->second;
     if (f.start_slot != 0) {
@@ -112,6 +114,10 @@ void WindowFeatures::remove_oldest(const SlotCameraPose& cam) {
       continue;
     } else {
       reanchor(f, c0, c1);
+      if (keep_past) {
+        if (static_cast<int>(f.past.size()) >= max_past_) f.past.erase(f.past.begin());
+        f.past.push_back({c0, f.obs[0].xy});
+      }
       f.obs.erase(f.obs.begin());
     }
     ++it;

@@ -29,8 +29,24 @@ struct FeatureObservation {
   Eigen::Vector2d px_right = Eigen::Vector2d::Zero();  ///< right pixel (outputs and scoring only)
 };
 
+/// cam0 pose in the world of a window slot: (R_wc, p_wc).
+struct CameraPose {
+  Eigen::Matrix3d R = Eigen::Matrix3d::Identity();
+  Eigen::Vector3d p = Eigen::Vector3d::Zero();
+};
+
+/// A feature's observation in a keyframe that has left the window, with that keyframe's pose as the
+/// estimator left it (mono track history; window_optimizer.cpp, history_inconsistent).
+struct PastObservation {
+  CameraPose cam;
+  Eigen::Vector2d xy = Eigen::Vector2d::Zero();  ///< cam0, z = 1 plane
+};
+
 struct WindowFeature {
   int64_t id = 0;
+  /// Its observations in the latest keyframes that left the window, oldest first (at most
+  /// WindowFeatures::max_past(); kept only when remove_oldest is asked to).
+  std::vector<PastObservation> past;
   int start_slot = 0;                   ///< window slot of obs[0] (the anchor)
   std::vector<FeatureObservation> obs;  ///< obs[k] is at slot start_slot + k
   double inv_depth = 0;                 ///< 1 / z in the anchor's cam0; the BA's parameter block
@@ -45,11 +61,6 @@ struct WindowFeature {
   bool in_ba() const { return has_depth && static_cast<int>(obs.size()) >= kMinObservationsInBa; }
 };
 
-/// cam0 pose in the world of a window slot: (R_wc, p_wc).
-struct CameraPose {
-  Eigen::Matrix3d R = Eigen::Matrix3d::Identity();
-  Eigen::Vector3d p = Eigen::Vector3d::Zero();
-};
 using SlotCameraPose = std::function<CameraPose(int slot)>;
 
 class WindowFeatures {
@@ -68,15 +79,27 @@ class WindowFeatures {
   /// Drops slot 0 (after the window's oldest keyframe was marginalised): features anchored there lose
   /// their first observation and are re-anchored at the next (depth carried over through the world
   /// point); features left without observations are erased. Every slot index shifts down by one.
-  /// `cam` gives the poses of the slots BEFORE the shift.
-  void remove_oldest(const SlotCameraPose& cam);
+  /// `cam` gives the poses of the slots BEFORE the shift. With `keep_past` (and max_past() > 0) the dropped
+  /// observation joins the feature's `past`, with slot 0's pose, and past_frame() becomes slot 1's.
+  void remove_oldest(const SlotCameraPose& cam, bool keep_past = false);
+
+  /// How many past observations a feature keeps (0, the default: none).
+  void set_max_past(int n) { max_past_ = n; }
+  int max_past() const { return max_past_; }
+  /// The pose slot 0 had when the past observations were last added. The past poses are in the world as
+  /// it was then; a solve moves the whole window in position and yaw before the gauge moves it back
+  /// (window_gauge.hpp), so a reader maps them through slot 0's pose now against this one.
+  const CameraPose& past_frame() const { return past_frame_; }
   /// Drops slot `slot` (the second newest, not kept as keyframe): its observations go, later slots shift
   /// down by one; a feature anchored there is re-anchored at the following slot.
   void remove_slot(int slot, const SlotCameraPose& cam);
 
   /// Erases features whose depth became invalid in the solve (behind the camera); returns how many.
   int remove_bad_depths();
-  void clear() { features_.clear(); }
+  void clear() {
+    features_.clear();
+    past_frame_ = CameraPose{};
+  }
 
   std::map<int64_t, WindowFeature>& all() { return features_; }
   const std::map<int64_t, WindowFeature>& all() const { return features_; }
@@ -88,6 +111,8 @@ class WindowFeatures {
 
   std::map<int64_t, WindowFeature> features_;  // node-based: inv_depth / weight addresses stay valid
   int last_track_num_ = 0;
+  int max_past_ = 0;
+  CameraPose past_frame_;
 };
 
 /// Linear (DLT) two-view triangulation of normalized observations x0, x1 with camera poses in a

@@ -206,6 +206,30 @@ double median_kept_depth(const std::vector<WindowFeature*>& features) {
   return d[d.size() / 2];
 }
 
+/// Mono: does the track's recent life contradict a static point? `window_fit` is its fit over the window
+/// (feature_residual_with), `past` its observations in the keyframes that left the window, `now_from_past` maps
+/// their poses into the window's world of the moment. A point riding with the camera a few metres ahead (the
+/// car ahead in its lane, at its speed) fits a static point within one window: against the forward motion its
+/// bearing keeps still as a far point's would, while the camera's lane weaving gives it the parallax of a
+/// nearer one, so depth_unobservable does not catch it, eq. 10 keeps it, and in the state step it drags the
+/// attitude and the scale (on `street_jam`, mono, the two vehicles ahead of the camera were half the error;
+/// README, "Street scenes"). Over the keyframes before the window the camera drove several times as far, and
+/// no one static point explains them all: the track's r_j over the window and its past together (the depth
+/// refitted, the poses as estimated) is beyond eq. 7's line r_j = λw (w_j = 0.5). A static track's past fits
+/// as well as its window does, up to the drift of the poses over those keyframes.
+bool history_inconsistent(const FeatureGeometry& window_fit, const std::vector<PastObservation>& past,
+                          const Eigen::Isometry3d& now_from_past, const FeatureWeightParams& p, FeatureGeometry& g) {
+  g = window_fit;
+  for (const PastObservation& o : past) {
+    CameraPose c;
+    c.R = now_from_past.linear() * o.cam.R;
+    c.p = now_from_past * o.cam.p;
+    g.obs.push_back({c, o.xy, true});
+  }
+  g.inverse_depth = g.best_inverse_depth(window_fit.inverse_depth);
+  return g.weighted_mean(g.inverse_depth, p) > p.lambda_w;
+}
+
 }  // namespace
 
 double WindowOptimizer::feature_residual(const WindowState& s, const WindowFeature& f) const {
@@ -348,9 +372,11 @@ class StateSolver {
 /// The weight step (paper eq. 10 in closed form, solve_feature_weight) with the states fixed.
 class WeightStep {
  public:
+  /// `past_frame`: WindowFeatures::past_frame() when the features keep past observations, else null.
   WeightStep(const WindowState& s, int newest, const WindowSolveOptions& opt, const ImuPathFromRest* rest_path,
-             SolveStats& st)
-      : s_(s), newest_(newest), opt_(opt), rest_path_(rest_path), st_(st), cameras_(newest + 1) {}
+             const CameraPose* past_frame, SolveStats& st)
+      : s_(s), newest_(newest), opt_(opt), rest_path_(rest_path), past_frame_(past_frame), st_(st),
+        cameras_(newest + 1) {}
 
   /// Updates every feature's w_j from its residual r_j at the current states; returns the share of
   /// weights that moved less than settle_tolerance.
@@ -369,6 +395,14 @@ class WeightStep {
     int settled = 0;
     const bool judge_depth = !opt_.stereo && opt_.mono_max_depth_baselines > 0;  // depth_unobservable
     const double depth_median = judge_depth ? median_kept_depth(features) : 0.0;
+    const bool judge_history = !opt_.stereo && past_frame_;  // history_inconsistent
+    Eigen::Isometry3d now_from_past = Eigen::Isometry3d::Identity();
+    if (judge_history) {
+      // Slot 0 now against slot 0 when the past was recorded: the window floats within a solve.
+      const CameraPose now = s_.camera(0, 0);
+      now_from_past.linear() = now.R * past_frame_->R.transpose();
+      now_from_past.translation() = now.p - now_from_past.linear() * past_frame_->p;
+    }
     for (WindowFeature* f : features) {
       const double r = feature_residual_with(*f, opt_, camera, geometry_);
       const double w = solve_feature_weight(r, f->weight_prev, f->times_solved, opt_.weights);
@@ -376,7 +410,9 @@ class WeightStep {
       f->weight = w;
       // eq. 10 keeps such a track (it fits a point at infinity); it only stays out of the state step.
       const bool unobservable =
-          judge_depth && depth_unobservable(geometry_, opt_.mono_max_depth_baselines, depth_median);
+          (judge_depth && depth_unobservable(geometry_, opt_.mono_max_depth_baselines, depth_median)) ||
+          (judge_history && !f->past.empty() &&
+           history_inconsistent(geometry_, f->past, now_from_past, opt_.weights, history_geometry_));
       f->state_weight = unobservable ? 0.0 : state_step_weight(w, opt_.weights);
       f->state_weight = oracle_state_weight(f->state_weight, f->sim_label, opt_.weights);  // 0 = off: unchanged
     }
@@ -389,9 +425,10 @@ class WeightStep {
   int newest_;
   const WindowSolveOptions& opt_;
   const ImuPathFromRest* rest_path_;
+  const CameraPose* past_frame_;
   SolveStats& st_;
   std::vector<std::array<CameraPose, 2>> cameras_;
-  FeatureGeometry geometry_;
+  FeatureGeometry geometry_, history_geometry_;
 };
 
 /// Alternating optimisation of eq. (11) (paper III-C): the weights w_j by eq. (10) with the states fixed,
@@ -399,8 +436,9 @@ class WeightStep {
 /// `alternating_converge` with Ceres converged, `max_alternations` is reached or the budget is spent.
 /// Afterwards w̄_j = w_j and n_j grows by one (the momentum of eq. 9 for the next solve).
 void alternate(const WindowState& s, int newest, const std::vector<WindowFeature*>& features,
-               const WindowSolveOptions& opt, const ImuPathFromRest* rest_path, StateSolver& solver, SolveStats& st) {
-  WeightStep weight_step(s, newest, opt, rest_path, st);
+               const WindowSolveOptions& opt, const ImuPathFromRest* rest_path, const CameraPose* past_frame,
+               StateSolver& solver, SolveStats& st) {
+  WeightStep weight_step(s, newest, opt, rest_path, past_frame, st);
   // Start from the previous weights (momentum's w̄) so "settled" compares against where we were.
   for (WindowFeature* f : features) f->weight = f->weight_prev;
   weight_step(features);
@@ -428,7 +466,8 @@ SolveStats WindowOptimizer::solve(WindowState& s, int newest, WindowFeatures& fe
   st.features_in_window = static_cast<int>(window.features().size());
   StateSolver solver(window.problem(), opt_, st);
   if (opt_.loss == BaLoss::Dynavins) {
-    alternate(s, newest, window.features(), opt_, rest_path, solver, st);
+    const CameraPose* past_frame = features.max_past() > 0 ? &features.past_frame() : nullptr;
+    alternate(s, newest, window.features(), opt_, rest_path, past_frame, solver, st);
   } else {
     solver.run(solver.iterations_left());  // eq. 1, Huber loss on the visual residuals
   }

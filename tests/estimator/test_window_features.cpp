@@ -107,6 +107,39 @@ TEST_CASE("stereo depths, slot shifts and re-anchoring keep every feature on its
   }
 }
 
+TEST_CASE("the oldest slot's observations join the tracks' past with its pose, the latest max_past kept",
+          "[window_features]") {
+  const Scene s = make_scene(30);
+  WindowFeatures wf;
+  wf.set_max_past(3);
+  // Slots 0..5; each removal drops the oldest, as the estimator's slide does.
+  std::vector<CameraPose> cams;
+  for (int k = 0; k < 6; ++k) {
+    cams.push_back(s.camera(k));
+    wf.add_frame(k, s.frame(k, 0, 30, Eigen::Isometry3d::Identity()), 10.0 / kNominalFocalPx, false);
+  }
+  wf.remove_oldest([&](int k) { return cams[k]; }, false);  // before the initialisation: nothing kept
+  cams.erase(cams.begin());
+  for (const auto& [id, f] : wf.all()) CHECK(f.past.empty());
+  for (int r = 1; r <= 4; ++r) {
+    wf.remove_oldest([&](int k) { return cams[k]; }, true);
+    CHECK(wf.past_frame().p.isApprox(cams[1].p));  // the new slot 0
+    cams.erase(cams.begin());
+  }
+  // Slots 1..4 left the window with their observations; the latest three (2, 3, 4) are kept, oldest first.
+  for (const auto& [id, f] : wf.all()) {
+    REQUIRE(f.past.size() == 3);
+    for (int i = 0; i < 3; ++i) {
+      const CameraPose c = s.camera(2 + i);
+      const Eigen::Vector3d p_c = c.R.transpose() * (s.points[id] - c.p);
+      CHECK(f.past[i].cam.p.isApprox(c.p));
+      CHECK((f.past[i].xy - p_c.head<2>() / p_c.z()).norm() < 1e-12);
+    }
+  }
+  wf.clear();
+  CHECK(wf.past_frame().p.isZero());
+}
+
 TEST_CASE("keyframe decision follows parallax and new features", "[window_features]") {
   const Scene s = make_scene(100);
   const Eigen::Isometry3d T = Eigen::Isometry3d::Identity();

@@ -38,6 +38,10 @@ struct WindowSetup {
   double static_depth_scale = 1.0;  ///< static points at 3-10 m times this
   /// Points that translate with the camera (a truck leading it at its speed), seen in every slot; made last.
   int riders = 0;
+  /// Points that move 0.3 m per frame across the view until slot kStopSlot and stand still from then on,
+  /// seen in every slot; made after the riders.
+  int stoppers = 0;
+  static constexpr int kStopSlot = 5;
 };
 
 /// A window with its ground truth. Slot 0 starts at the truth; the gauge (position and yaw of slot 0)
@@ -166,6 +170,16 @@ SyntheticWindow::SyntheticWindow(const WindowSetup& setup) {
     // what a point at infinity looks like.
     const Eigen::Vector3d offset = scenario.R_wc(0) * Eigen::Vector3d(0.5 * u(rng), 0.3 * u(rng), 3.5 + 0.5 * u(rng));
     if (addTrack(id, 0, kWindowSize, [&](int k) { return Eigen::Vector3d(scenario.p_wc(k) + offset); })) {
+      moving_ids.insert(id);
+      ++made;
+    }
+    ++id;
+  }
+  for (int made = 0; made < setup.stoppers;) {
+    const Eigen::Vector3d stop = scenario.R_wc(0) * Eigen::Vector3d(0.8 * u(rng), 0.5 * u(rng), 5.0 + u(rng)) + scenario.p_wc(0);
+    const Eigen::Vector3d step = 0.3 * (scenario.R_wc(0) * Eigen::Vector3d(u(rng) > 0 ? 1.0 : -1.0, 0.3 * u(rng), 0.0)).normalized();
+    const auto point = [&](int k) { return Eigen::Vector3d(stop - std::max(0, WindowSetup::kStopSlot - k) * step); };
+    if (addTrack(id, 0, kWindowSize, point)) {
       moving_ids.insert(id);
       ++made;
     }
@@ -360,6 +374,56 @@ TEST_CASE(
     // Without the rule some pass for points at infinity (the others' BA depth went behind the camera in the
     // first state solve, where the weight step's depth fit cannot follow, and eq. 10 rejects them).
     if (k == 0) CHECK(riders_kept > 0);
+  }
+}
+
+TEST_CASE("mono: a track whose past keyframes contradict the static point its window fits stays out of the "
+          "state step (mono_history_keyframes)",
+          "[estimator][window_optimizer]") {
+  // Points that crossed the view and then stood still: within the window left after the first five
+  // keyframes slid out they fit a static point (eq. 10 keeps them); with the five in their past they do
+  // not. The static tracks' past fits, so they stay in. The slide is the estimator's: the features drop
+  // slot 0 into their past with its pose, the states move down a slot.
+  WindowSetup setup;
+  setup.mono = true;
+  setup.moving_features = 0;
+  setup.stoppers = 8;
+  for (const int history : {16, 0}) {
+    INFO("mono_history_keyframes " << history);
+    SyntheticWindow w(setup);
+    w.features.set_max_past(history);
+    int newest = w.newest();
+    for (int r = 0; r < WindowSetup::kStopSlot; ++r) {
+      w.features.remove_oldest([&w](int k) { return w.state.camera(k, 0); }, true);
+      for (int k = 0; k < newest; ++k) w.state.move_slot(k + 1, k);
+      w.state.preint[0].reset();
+      --newest;
+    }
+    WindowSolveOptions o = solve_options(BaLoss::Dynavins);
+    o.stereo = false;
+    WindowOptimizer(o).solve(w.state, newest, w.features);
+    int stoppers = 0, stoppers_kept = 0, static_with_past = 0;
+    for (const auto& [id, f] : w.features.all()) {
+      INFO("feature " << id << (w.moving(id) ? " (stopped)" : " (static)") << ", " << f.past.size()
+                      << " past, weight " << f.weight << ", state step weight " << f.state_weight);
+      CHECK(static_cast<int>(f.past.size()) <= history);
+      if (!w.moving(id)) {
+        static_with_past += !f.past.empty();
+        CHECK(f.state_weight > 0.9);
+      } else {
+        ++stoppers;
+        CHECK(f.past.size() == (history > 0 ? WindowSetup::kStopSlot : 0));
+        CHECK(f.weight > 0.5);  // eq. 10 on the window alone keeps it
+        stoppers_kept += f.state_weight > 0.5;
+      }
+    }
+    CHECK(stoppers == setup.stoppers);
+    if (history > 0) {
+      CHECK(static_with_past > 0);
+      CHECK(stoppers_kept == 0);
+    } else {
+      CHECK(stoppers_kept == stoppers);
+    }
   }
 }
 
