@@ -212,7 +212,7 @@ double median_kept_depth(const std::vector<WindowFeature*>& features) {
 /// car ahead in its lane, at its speed) fits a static point within one window: against the forward motion its
 /// bearing keeps still as a far point's would, while the camera's lane weaving gives it the parallax of a
 /// nearer one, so depth_unobservable does not catch it, eq. 10 keeps it, and in the state step it drags the
-/// attitude and the scale (on `street_jam`, mono, the two vehicles ahead of the camera were half the error;
+/// attitude and the scale (on `street_jam`, mono, the two vehicles ahead were three fifths of its excess over its twin;
 /// README, "Street scenes"). Over the keyframes before the window the camera drove several times as far, and
 /// no one static point explains them all: the track's r_j over the window and its past together (the depth
 /// refitted, the poses as estimated) is beyond eq. 7's line r_j = λw (w_j = 0.5). A static track's past fits
