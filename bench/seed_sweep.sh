@@ -3,10 +3,11 @@
 # percent either way. This runs scenes at several noise seeds (same world, path and traffic; other IMU
 # and image noise and object textures) with huber and with dynavins under up to three settings, and prints
 # each ATE and the mean over the seeds, so a change is judged by its mean, not by one draw.
-# Usage: bench/seed_sweep.sh --seeds 21,22,23 [--mono] [--a "--set k=v ..."] [--b "..."] [--c "..."]
-#                            SCENARIO...
+# Usage: bench/seed_sweep.sh --seeds 21,22,23 [--mono] [--rig viode] [--a "--set k=v ..."] [--b "..."]
+#                            [--c "..."] SCENARIO...
 #   --a / --b / --c: dynavins run options of up to three settings compared (default: --a "" i.e. the
 #              defaults, no --b or --c). Scenes are cached as bench/cache/NAME-seedS (scripts/cached-sim.sh).
+#   --rig:     render with another stereo rig (`dynavins sim --rig`; cached as NAME-RIG-seedS).
 # Every run is `dynavins run --rate 0 --loop off` (lossless, deterministic). Writes runs to
 # bench/results/seed_sweep/ (not kept in git) and the table to stdout.
 # Example (the README's "Street scenes" table, seeds 22-24; bench/results/seed_sweep.md has the others):
@@ -16,15 +17,16 @@ set -euo pipefail
 cd "$(dirname "$0")/.."
 bin=$(readlink -f "${DYNAVINS:-build/bin/dynavins}")
 python=${PYTHON:-/usr/bin/python3}
-seeds=""; mono=(); a=""; b=""; c=""; have_b=0; have_c=0; scenes=()
+seeds=""; mono=(); rig=""; a=""; b=""; c=""; have_b=0; have_c=0; scenes=()
 while [ $# -gt 0 ]; do
   case $1 in
     --seeds) seeds=$2; shift ;;
     --mono) mono=(--mono) ;;
+    --rig) rig=$2; shift ;;
     --a) a=$2; shift ;;
     --b) b=$2; have_b=1; shift ;;
     --c) c=$2; have_c=1; shift ;;
-    -h|--help) sed -n '2,14p' "$0"; exit 0 ;;
+    -h|--help) sed -n '2,15p' "$0"; exit 0 ;;
     -*) echo "seed_sweep: unknown option $1" >&2; exit 2 ;;
     *) scenes+=("$1") ;;
   esac
@@ -51,9 +53,10 @@ run_one() {
 rows=()
 for sc in "${scenes[@]}"; do
   for s in ${seeds//,/ }; do
-    cache=$sc-seed$s
-    echo "seed_sweep: $sc seed $s${mono:+ (mono)}" >&2
-    if ! CACHE_AS=$cache DYNAVINS=$bin scripts/cached-sim.sh "$sc" --seed "$s" --euroc > "$out/$cache.sim.log" 2>&1; then
+    cache=$sc${rig:+-$rig}-seed$s
+    echo "seed_sweep: $sc seed $s${mono:+ (mono)}${rig:+ ($rig rig)}" >&2
+    if ! CACHE_AS=$cache DYNAVINS=$bin scripts/cached-sim.sh "$sc" --seed "$s" ${rig:+--rig "$rig"} --euroc \
+         > "$out/$cache.sim.log" 2>&1; then
       echo "seed_sweep: could not generate $sc at seed $s, see $out/$cache.sim.log" >&2
       exit 1
     fi

@@ -30,6 +30,7 @@ struct SimOptions {
   std::string out;
   std::optional<uint64_t> seed;
   std::optional<double> duration;
+  std::string rig;  ///< empty: the scenario's
   bool euroc = false;
   bool raw = false;
 };
@@ -58,7 +59,9 @@ void run_sim(const SimOptions& o) {
   const std::string path = resolve_scenario(o.scenario);
   std::shared_ptr<const sim::Scenario> scenario;
   try {
-    scenario = sim::build_scenario(sim::load_scenario(path), o.seed, o.duration);
+    sim::ScenarioSpec spec = sim::load_scenario(path);
+    if (!o.rig.empty()) spec.rig = o.rig;
+    scenario = sim::build_scenario(spec, o.seed, o.duration);
   } catch (const std::runtime_error& e) {
     throw CommandError(e.what(), 2);
   }
@@ -120,6 +123,9 @@ void add_sim_command(CLI::App& app) {
   cmd->add_option("--out", o->out, "Output folder")->required();
   cmd->add_option("--seed", o->seed, "Override the scenario's seed (noise, textures of moving objects)");
   cmd->add_option("--duration", o->duration, "Override the scenario's duration [s]")->check(CLI::PositiveNumber);
+  cmd->add_option("--rig", o->rig, "Override the scenario's stereo rig: euroc (0.11 m baseline, fx 458, radtan) or "
+                  "viode (0.05 m, fx 376, no distortion)")
+      ->check(CLI::IsMember({"euroc", "viode"}));
   cmd->add_flag("--euroc", o->euroc, "Also write an EuRoC ASL folder with a VINS-Fusion config");
   cmd->add_flag("--raw", o->raw, "Store images in the log as raw gray8 instead of PNG");
   cmd->callback([o] { run_sim(*o); });

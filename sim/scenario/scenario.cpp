@@ -1,6 +1,7 @@
 #include "sim/scenario/scenario.hpp"
 
 #include <cmath>
+#include <stdexcept>
 
 #include <spdlog/spdlog.h>
 
@@ -75,6 +76,15 @@ PathProfile profile_of(const ScenarioSpec& s) {
 
 }  // namespace
 
+namespace {
+/// cam1 = cam0 moved `baseline` along cam0's x axis.
+void place_cam1(StereoRig& rig) {
+  Eigen::Isometry3d T_cam0_cam1 = Eigen::Isometry3d::Identity();
+  T_cam0_cam1.translation() = Eigen::Vector3d(rig.baseline, 0, 0);
+  rig.T_body_cam1 = rig.T_body_cam0 * T_cam0_cam1;
+}
+}  // namespace
+
 StereoRig StereoRig::standard() {
   StereoRig rig;
   // Camera axes in the body frame (x forward, y left, z up): camera x right = -y, y down = -z,
@@ -88,10 +98,22 @@ StereoRig StereoRig::standard() {
   rig.T_body_cam0 = Eigen::Isometry3d::Identity();
   rig.T_body_cam0.linear() = R * tilt;
   rig.T_body_cam0.translation() = Eigen::Vector3d(0.06, 0.03, -0.02);
-  Eigen::Isometry3d T_cam0_cam1 = Eigen::Isometry3d::Identity();
-  T_cam0_cam1.translation() = Eigen::Vector3d(rig.baseline, 0, 0);
-  rig.T_body_cam1 = rig.T_body_cam0 * T_cam0_cam1;
+  place_cam1(rig);
   return rig;
+}
+
+StereoRig StereoRig::viode() {
+  StereoRig rig = standard();
+  rig.camera = CameraIntrinsics{752, 480, 376.0, 376.0, 376.0, 240.0, 0.0, 0.0, 0.0, 0.0};
+  rig.baseline = 0.05;
+  place_cam1(rig);
+  return rig;
+}
+
+StereoRig StereoRig::preset(const std::string& name) {
+  if (name == "euroc") return standard();
+  if (name == "viode") return viode();
+  throw std::runtime_error("unknown rig '" + name + "' (euroc | viode)");
 }
 
 namespace {
@@ -170,7 +192,7 @@ std::shared_ptr<const Scenario> build_scenario(const ScenarioSpec& spec, std::op
       world->add_moving_box(Eigen::Vector3d(0.12, 2.4, 1.8), pose, ++texture_seed, BoxStyle::Truck, "board");
   }
   s->world = world;
-  s->rig = StereoRig::standard();
+  s->rig = StereoRig::preset(spec.rig);
   s->photometric = spec.photometric == "night" ? PhotometricOptions::night() : PhotometricOptions{};
   s->photometric.seed = s->spec.seed;
   s->imu.seed = s->spec.seed;

@@ -25,6 +25,11 @@ struct StereoRig {
   double baseline = 0.11;          ///< [m]
   /// The project's standard rig (non-trivial extrinsics, EuRoC-like intrinsics, 0.11 m baseline).
   static StereoRig standard();
+  /// VIODE's cameras on the same mount: 752x480 pinhole without distortion, fx = fy = 376, a 0.05 m
+  /// baseline (a rig of other tools' scenes: half the stereo depth resolution of the standard one).
+  static StereoRig viode();
+  /// `euroc` (standard) or `viode`; throws std::runtime_error otherwise.
+  static StereoRig preset(const std::string& name);
 };
 
 struct Scenario {

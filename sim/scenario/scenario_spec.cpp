@@ -106,7 +106,7 @@ ScenarioSpec load_scenario(const std::string& path) {
   }
   const Reader r{path};
   const cv::FileNode root = fs.root();
-  r.only(root, "", {"name", "seed", "duration", "world", "motion", "photometric", "objects"});
+  r.only(root, "", {"name", "seed", "duration", "world", "motion", "photometric", "rig", "objects"});
   ScenarioSpec s;
   s.file = path;
   s.name = r.text(root, "name", "", {});
@@ -115,6 +115,7 @@ ScenarioSpec load_scenario(const std::string& path) {
   s.duration = r.number(root, "duration", false, 0);
   if (s.duration < 0) r.fail("duration", "must be >= 0");
   s.photometric = r.text(root, "photometric", "day", {"day", "night"});
+  s.rig = r.text(root, "rig", "euroc", {"euroc", "viode"});
 
   const cv::FileNode world = root["world"];
   if (!world.empty()) {

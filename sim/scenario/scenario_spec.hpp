@@ -51,6 +51,7 @@ struct ScenarioSpec {
   Eigen::Vector4d tum_placement = Eigen::Vector4d::Zero();  ///< x, y, z [m], yaw [deg] of the file's world in ours
   std::string tum_body_axes = "sim";  ///< sim: camera along body x; euroc: along the IMU's z, as on the EuRoC MAV
   std::string photometric = "day";  ///< day | night
+  std::string rig = "euroc";        ///< euroc | viode (StereoRig::preset)
   std::vector<MovingObjectSpec> objects;
 };
 

@@ -15,7 +15,7 @@ namespace fs = std::filesystem;
 namespace {
 
 /// 3 s along the avenue with a truck crossing 6 m ahead at t = 1.5 s and a car driving ahead.
-std::shared_ptr<const Scenario> short_scene() {
+std::shared_ptr<const Scenario> short_scene(const std::string& rig = "euroc") {
   const fs::path dir = fs::temp_directory_path() / "dynavins_test_scenario";
   fs::create_directories(dir);
   const fs::path path = dir / "short.yaml";
@@ -25,7 +25,9 @@ std::shared_ptr<const Scenario> short_scene() {
                          "objects:\n"
                          "  - { kind: truck, motion: cross_ahead, t: 2.0, distance: 7, speed: 6 }\n"
                          "  - { kind: car, motion: lane, x0: 15, y: -1.75, speed: 1 }\n";
-  return build_scenario(load_scenario(path.string()));
+  ScenarioSpec spec = load_scenario(path.string());
+  spec.rig = rig;
+  return build_scenario(spec);
 }
 
 }  // namespace
@@ -87,7 +89,9 @@ TEST_CASE("ScenarioSource: labels mark the moving objects where the geometry put
 }
 
 TEST_CASE("ScenarioSource: static pixels' depth is consistent between the stereo views", "[scenario]") {
-  ScenarioSource src(short_scene());
+  const std::string rig_name = GENERATE(as<std::string>{}, "euroc", "viode");
+  INFO("rig " << rig_name);
+  ScenarioSource src(short_scene(rig_name));
   SensorEvent e;
   while (src.next(e) && !std::holds_alternative<StereoFrame>(e)) {
   }

@@ -33,6 +33,7 @@ TEST_CASE("load_scenario reads every part of a scenario", "[scenario]") {
   CHECK(s.seed == 3);
   CHECK(s.duration == 12.5);
   CHECK(s.photometric == "night");
+  CHECK(s.rig == "euroc");  // the default
   CHECK(s.world_x_max == 90);
   CHECK(s.avenue_y == std::vector<double>{0, 60});
   CHECK(s.cross_street_x == std::vector<double>{40});
@@ -86,7 +87,26 @@ TEST_CASE("load_scenario: a wrong, unknown or missing key is an error naming key
   CHECK_THROWS_WITH(load_scenario(p), Catch::Contains("speed: missing"));
   p = write_yaml("wp.yaml", "name: t\nmotion: { waypoints: [0, 0, 1.5, 50, 0] }\n");
   CHECK_THROWS_WITH(load_scenario(p), Catch::Contains("groups of 3"));
+  p = write_yaml("rig.yaml", "name: t\nrig: kinect\n" + motion);
+  CHECK_THROWS_WITH(load_scenario(p), Catch::Contains("rig: 'kinect' is not one of"));
   CHECK_THROWS_WITH(load_scenario("/nonexistent/s.yaml"), Catch::Contains("/nonexistent/s.yaml"));
+}
+
+TEST_CASE("load_scenario: rig picks the stereo rig the scene is rendered with", "[scenario]") {
+  const auto path = write_yaml("viode.yaml", "name: t\nrig: viode\nduration: 1\n"
+                                             "motion: { waypoints: [0, -1.5, 1.6, 30, -1.5, 1.6] }\n");
+  const ScenarioSpec spec = load_scenario(path);
+  CHECK(spec.rig == "viode");
+  const auto s = build_scenario(spec);
+  CHECK(s->rig.camera.fx == 376.0);
+  CHECK(s->rig.camera.k1 == 0.0);
+  const Eigen::Isometry3d c0_c1 = s->rig.T_body_cam0.inverse() * s->rig.T_body_cam1;
+  CHECK((c0_c1.translation() - Eigen::Vector3d(0.05, 0, 0)).norm() < 1e-12);
+  const auto config = vins_config(*s);  // what `sim --euroc` hands the estimator
+  CHECK(config.cam0.fx == 376.0);
+  CHECK(((config.body_T_cam0.inverse() * config.body_T_cam1).translation() - Eigen::Vector3d(0.05, 0, 0)).norm() < 1e-12);
+  CHECK(StereoRig::preset("euroc").baseline == 0.11);
+  CHECK_THROWS(StereoRig::preset("kinect"));
 }
 
 TEST_CASE("load_scenario: motion.dwell stops the path at a waypoint for that long", "[scenario]") {
