@@ -102,22 +102,28 @@ int main(int argc, char** argv) {
   std::optional<uint64_t> seed;
   std::optional<double> duration;
   bool mono = false;
+  std::string rig;
   std::vector<std::string> sets;
   app.add_option("--scenario", scenario, "Name in bench/scenarios or a file")->capture_default_str();
   app.add_option("--seed", seed, "Noise seed (default: the scenario's)");
   app.add_option("--duration", duration, "Seconds to simulate (default: the scenario's)");
   app.add_flag("--mono", mono, "Left image only");
-  app.add_option("--set", sets, "Override an option by its config key, --set key=value (repeatable; only the tracker's keys act here)");
+  app.add_option("--rig", rig, "Override the scenario's stereo rig (as dynavins sim --rig): euroc or viode");
+  app.add_option(
+      "--set", sets,
+      "Override an option by its config key, --set key=value (repeatable; only the tracker's keys act here)");
   CLI11_PARSE(app, argc, argv);
 
   std::string path = scenario;
-  if (!std::filesystem::is_regular_file(path)) path = std::string(DYNAVINS_SOURCE_DIR) + "/bench/scenarios/" + scenario + ".yaml";
+  if (!std::filesystem::is_regular_file(path))
+    path = std::string(DYNAVINS_SOURCE_DIR) + "/bench/scenarios/" + scenario + ".yaml";
   std::shared_ptr<const sim::Scenario> sc;
   tracker::TrackerOptions options;
   EstimatorOptions est;
   try {
-    const sim::ScenarioSpec spec = sim::load_scenario(path);
+    sim::ScenarioSpec spec = sim::load_scenario(path);
     if (!seed) seed = spec.seed;
+    if (!rig.empty()) spec.rig = rig;
     sc = sim::build_scenario(spec, seed, duration);
     est = sim::scenario_estimator_options(*sc);
     for (const std::string& s : sets) {
@@ -225,9 +231,19 @@ int main(int argc, char** argv) {
   for (const auto& [id, obs] : seen)
     if (obs.size() >= 5) fit_residuals(obs, &fit);
   print_stats("fit (5+ observations)", fit);
-  if (!mono) print_stats("stereo", stereo);
+  if (!mono) {
+    print_stats("stereo", stereo);
+    // Wrong matches, which the flow-back check lets through: each one is a depth the estimator trusts.
+    const auto share = [&](double px) {
+      return 100.0 *
+             static_cast<double>(std::count_if(stereo.begin(), stereo.end(), [px](double e) { return e > px; })) /
+             static_cast<double>(std::max<std::size_t>(1, stereo.size()));
+    };
+    std::printf("stereo outliers        > 1 px %.2f %%, > 3 px %.2f %%\n", share(1.0), share(3.0));
+  }
   {
-    std::printf("static observations by distance to moving pixels: error, > 2 px, mean error along the true image motion\n");
+    std::printf(
+        "static observations by distance to moving pixels: error, > 2 px, mean error along the true image motion\n");
     std::printf("since the first observation (negative: lagging), of all and of those within 2 px\n");
     for (NearMovingBand& b : near) {
       if (b.err.empty()) continue;

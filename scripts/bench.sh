@@ -59,7 +59,7 @@ elif [ "$quick" = 2 ]; then
   extra_seeds=()
 else
   scenarios=(none low mid high night mav_none mav_high standstill_none standstill_high dynamic_follow temporal_static e_shape revisit temporal_revisit
-             street_none street_crowd street_crowd_night street_jam street_follow_none street_follow
+             street_none street_crowd street_crowd_night street_jam street_rush street_follow_none street_follow
              street_turns_none street_turns)
   sim_args=()
   suffix=""

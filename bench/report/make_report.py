@@ -27,7 +27,8 @@ import matplotlib.pyplot as plt  # noqa: E402
 
 SCENARIO_ORDER = ["none", "low", "mid", "high", "night", "mav_none", "mav_high", "standstill_none", "standstill_high",
                   "dynamic_follow", "temporal_static", "e_shape", "revisit", "temporal_revisit",
-                  "street_none", "street_crowd", "street_crowd_night", "street_jam", "street_follow_none", "street_follow",
+                  "street_none", "street_crowd", "street_crowd_night", "street_jam", "street_rush",
+                  "street_follow_none", "street_follow",
                   "street_turns_none", "street_turns"]
 # Degradation pairs (dynamic scene, its static twin). The main ones (bold in Table III, rows of the README
 # headline): the VIODE-like `high`, the same measure under recorded MAV motion, and the fast street drives
@@ -35,11 +36,11 @@ SCENARIO_ORDER = ["none", "low", "mid", "high", "night", "mav_none", "mav_high",
 # low, mid and night against none are context, and so are the standstill pair (trucks pass a camera that stands still) and the
 # crowd at night (the night camera) against the static street by day.
 MAIN_PAIRS = [("high", "none"), ("mav_high", "mav_none"), ("street_crowd", "street_none"),
-              ("street_jam", "street_none"), ("street_follow", "street_follow_none"),
+              ("street_jam", "street_none"), ("street_rush", "street_none"), ("street_follow", "street_follow_none"),
               ("street_turns", "street_turns_none")]
 DEGRADATION_PAIRS = [MAIN_PAIRS[0], ("low", "none"), ("mid", "none"), ("night", "none"), MAIN_PAIRS[1],
                      ("standstill_high", "standstill_none"), MAIN_PAIRS[2], ("street_crowd_night", "street_none"),
-                     MAIN_PAIRS[3], MAIN_PAIRS[4], MAIN_PAIRS[5]]
+                     MAIN_PAIRS[3], MAIN_PAIRS[4], MAIN_PAIRS[5], MAIN_PAIRS[6]]
 # Loop-closure scenes (paper IV): Table II gives their odometry (odometry.tum); the loop-closure section
 # compares the loop modes' trajectory.tum. LOOP_SCENES run with --loop all / switchable too (scripts/bench.sh).
 ODOMETRY_ONLY = {"dynamic_follow", "temporal_static", "e_shape", "revisit", "temporal_revisit"}

@@ -42,6 +42,7 @@ const std::vector<OptionSpec>& option_specs() {
       {"zero_velocity_sigma", &O::zero_velocity_sigma, {1e-4, 1}, "m/s", "sigma of the zero-velocity factor (zupt)"},
       {"acc_bias_prior_sigma", &O::acc_bias_prior_sigma, {0, 10}, "m/s^2", "prior on the accelerometer bias at the start, per axis, kept by the marginalisation (ours, issue 23; off: helps the city-block drive, costs the other streets and the night, README); 0 = off"},
       {"imu_max_gap", &O::imu_max_gap, {0.01, 1}, "s", "an IMU outage longer than this resets the estimator; shorter ones are bridged"},
+      {"max_blind_time", &O::max_blind_time, {0, 60}, "s", "while fewer than 2 features are tracked from the previous frame (a truck crossing close in front, black images) the IMU alone carries the estimate, for at most this long, then it resets (ours; VINS-Fusion never resets for it); 0 = reset at once"},
       // IMU (continuous-time standard deviations).
       {"acc_n", &O::acc_n, {0, 10, true}, "m/s^2/sqrt(Hz)", "accelerometer noise", true},
       {"gyr_n", &O::gyr_n, {0, 10, true}, "rad/s/sqrt(Hz)", "gyroscope noise", true},

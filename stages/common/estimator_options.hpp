@@ -76,6 +76,10 @@ struct EstimatorOptions {
   /// it helps the city-block drive and costs `none`, the once-turning streets and the night (README).
   double acc_bias_prior_sigma = 0.0;
   double imu_max_gap = 0.1;  ///< s; a longer IMU outage inside an interval resets the estimator
+  /// s, ours: how long the IMU alone carries the estimate while fewer than 2 features are tracked from the
+  /// previous frame (a truck crossing close in front: `street_rush`), before the estimator resets. VINS-Fusion
+  /// never resets for this (it logs "little feature"); 0 = reset at once, as this project did before.
+  double max_blind_time = 3.0;
 
   // IMU noise (continuous-time standard deviations); required when imu is 1.
   double acc_n = 0.1, gyr_n = 0.01, acc_w = 0.001, gyr_w = 0.0001, g_norm = 9.81;

@@ -135,6 +135,7 @@ struct SlidingWindowEstimator::Impl {
   ImuStillVelocity imu_still;     ///< zupt_imu: the IMU's velocity since the last moving solve
   ImuPathFromRest rest_path;      ///< zupt_imu: the IMU-only path from the last frame at rest
   bool judge_on_rest_path = false;  ///< zupt_imu: the solve left that path; the weight step uses it
+  int64_t blind_since_ns = -1;  ///< first frame of the current run tracking fewer than 2 features (max_blind_time)
 };
 
 void SlidingWindowEstimator::Impl::clear_window() {
@@ -152,6 +153,7 @@ void SlidingWindowEstimator::Impl::reset_all() {
   imu_still.restart(Eigen::Vector3d::Zero());
   rest_path.clear();
   judge_on_rest_path = false;
+  blind_since_ns = -1;
   optimizer.reset();
   init_history.clear();
   scale_failures = 0;
@@ -419,8 +421,22 @@ void SlidingWindowEstimator::Impl::apply_mono_init(const MonoInitResult& r) {
 
 std::string SlidingWindowEstimator::Impl::failure_reason(const Eigen::Vector3d& last_p,
                                                         const Eigen::Quaterniond& last_q) {
-  // VINS-Fusion's failureDetection thresholds.
-  if (features.last_tracked_count() < 2) return "fewer than 2 features tracked";
+  // VINS-Fusion's failureDetection thresholds, but for the "little feature" one: VINS-Fusion only logs it and
+  // goes on. A truck crossing close in front hides every static corner for a moment, and the IMU carries the
+  // window through that; a view lost for longer than max_blind_time (black images, a covered lens) resets.
+  if (features.last_tracked_count() < 2) {
+    const int64_t t = state.t_ns[newest];
+    if (blind_since_ns < 0) {
+      blind_since_ns = t;
+      spdlog::info("t={:.3f}: fewer than 2 features tracked from the previous frame: the IMU carries the estimate "
+                   "(for at most max_blind_time = {} s)",
+                   t * 1e-9, opt.max_blind_time);
+    }
+    if (t - blind_since_ns >= std::llround(opt.max_blind_time * 1e9))
+      return fmt::format("fewer than 2 features tracked for {:.2f} s (max_blind_time)", (t - blind_since_ns) * 1e-9);
+  } else {
+    blind_since_ns = -1;
+  }
   if (state.ba(newest).norm() > 2.5) return "accelerometer bias estimate above 2.5 m/s^2";
   if (state.bg(newest).norm() > 1.0) return "gyroscope bias estimate above 1 rad/s";
   const Eigen::Vector3d dp = state.p(newest) - last_p;

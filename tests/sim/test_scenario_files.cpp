@@ -145,6 +145,7 @@ TEST_CASE("The street family: every traffic scene is its static twin's drive", "
                                                        {"street_crowd_night", "street_none"},
                                                        {"street_crowd_night", "street_none_night"},
                                                        {"street_jam", "street_none"},
+                                                       {"street_rush", "street_none"},
                                                        {"street_follow", "street_follow_none"},
                                                        {"street_turns", "street_turns_none"}};
   for (const auto& [scene, twin_name] : pairs) {

@@ -1,9 +1,11 @@
 // Estimator faults (issue 22), injected into a short static street (tests/data/scenarios/
 // street_static_short.yaml, 12 s at 3 m/s) on its way to the shipped chain (run_vio_sequential, rate 0):
 // both cameras go black for 2 s, then a burst of frames never arrives, then the IMU biases jump; in a
-// second run the whole view moves for 2 s (a textured wall slides across both cameras). What a robot
+// second run the whole view moves for 2 s (a textured wall slides across both cameras); in a third the black-out
+// resets at once (max_blind_time = 0). What a robot
 // needs from the estimate through all this: no NaN, no silent jump of the pose (a discontinuity is only
 // allowed where a reset is reported, with its reason), and tracking again once the images are back.
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -34,13 +36,17 @@ struct FaultRun {
   int64_t start_ns = 0;                                       ///< the plan's time origin
 };
 
-FaultRun run_with_faults(const test::FaultPlan& plan) {
-  const auto sc = sim::build_scenario(sim::load_scenario(std::string(DYNAVINS_SOURCE_DIR) +
-                                                         "/tests/data/scenarios/street_static_short.yaml"));
+/// `max_blind_time`: the estimator's key (default when not given); `duration`: seconds of the scene to run.
+FaultRun run_with_faults(const test::FaultPlan& plan, std::optional<double> max_blind_time = std::nullopt,
+                         std::optional<double> duration = std::nullopt) {
+  const auto spec =
+      sim::load_scenario(std::string(DYNAVINS_SOURCE_DIR) + "/tests/data/scenarios/street_static_short.yaml");
+  const auto sc = sim::build_scenario(spec, spec.seed, duration);
   sim::ScenarioSource scene(sc);
   test::FaultInjectionSource src(scene, plan);
   pipeline::VioRunOptions opt;
   opt.estimator = sim::scenario_estimator_options(*sc);
+  if (max_blind_time) opt.estimator.max_blind_time = *max_blind_time;
   opt.show_progress = false;
   FaultRun run;
   pipeline::VioSinks sinks;
@@ -98,6 +104,43 @@ void check_reported_and_recovered(const FaultRun& run, int64_t recovered_after_n
   CHECK(estimates.back().status == estimator::EstimatorStatus::Tracking);
 }
 
+/// Through the event [from_ns, to_ns) the estimate either stops tracking (and says why, checked by
+/// check_reported_and_recovered) or moves as the truth did: every tracking estimate inside it, measured from the
+/// last tracking one before it with no reset between, moved (in that frame's body axes) as the truth did, within
+/// 0.5 m. Returns how many tracking estimates it compared and, through `back_ns`, how long after the event
+/// the first tracking estimate came (-1: none).
+int check_not_misled(const FaultRun& run, int64_t from_ns, int64_t to_ns, int64_t* back_ns) {
+  const auto truth_at = [&](int64_t t_ns) -> const GroundTruthState& {
+    for (const auto& g : run.result.ground_truth)
+      if (g.t_ns >= t_ns) return g;
+    return run.result.ground_truth.back();
+  };
+  const estimator::WindowEstimate* before = nullptr;
+  int tracking_inside = 0;
+  *back_ns = -1;
+  for (const auto& e : run.estimates) {
+    const int64_t t = e.t_ns - run.start_ns;
+    const bool tracking = e.status == estimator::EstimatorStatus::Tracking;
+    if (t < from_ns) {
+      before = tracking ? &e : nullptr;
+      continue;
+    }
+    if (t >= to_ns) {
+      if (tracking && *back_ns < 0) *back_ns = t - to_ns;
+      continue;
+    }
+    if (!tracking) before = nullptr;  // a reset: nothing to compare with until it tracks again
+    if (!tracking || before == nullptr) continue;
+    ++tracking_inside;
+    const GroundTruthState &ga = truth_at(before->t_ns), &gb = truth_at(e.t_ns);
+    const Eigen::Vector3d est = before->state.q_wb.conjugate() * (e.state.p_wb - before->state.p_wb);
+    const Eigen::Vector3d truth = ga.q_wb.conjugate() * (gb.p_wb - ga.p_wb);
+    INFO("t = " << t * 1e-9 << " s in the event: estimated " << est.transpose() << ", true " << truth.transpose());
+    CHECK((est - truth).norm() < 0.5);
+  }
+  return tracking_inside;
+}
+
 }  // namespace
 
 TEST_CASE("black images, dropped frames and a bias jump: reported, never NaN, no silent jump, recovered",
@@ -114,6 +157,33 @@ TEST_CASE("black images, dropped frames and a bias jump: reported, never NaN, no
   REQUIRE(run.frames_dropped > 5);
   // Recovered: in the last 2 s (2.9 s after the bias jump) the estimator tracks again.
   check_reported_and_recovered(run, 10 * kSec);
+  // 2 s without a picture is within max_blind_time (3 s): the IMU carries the estimate through the black-out,
+  // no reset, and it moves as the truth did.
+  int64_t back_ns = -1;
+  const int tracking_in_black = check_not_misled(run, plan.black_from_ns, plan.black_to_ns, &back_ns);
+  CHECK(tracking_in_black > 30);
+  for (const auto& e : run.estimates)
+    if (e.t_ns - run.start_ns >= plan.black_from_ns && e.t_ns - run.start_ns < plan.black_to_ns + kSec)
+      CHECK(e.status != estimator::EstimatorStatus::Reset);
+}
+
+TEST_CASE("max_blind_time = 0: black images reset the estimator at once, with the reason", "[vio][faults]") {
+  test::FaultPlan plan;
+  plan.black_from_ns = 3 * kSec + kSec / 2, plan.black_to_ns = 5 * kSec + kSec / 2;
+  const FaultRun run = run_with_faults(plan, 0.0, 9.0);
+  REQUIRE(run.result.report.ok);
+  int resets_in_black = 0;
+  for (const auto& e : run.estimates) {
+    const int64_t t = e.t_ns - run.start_ns;
+    if (e.status != estimator::EstimatorStatus::Reset) continue;
+    INFO("t = " << t * 1e-9 << " s: " << e.event);
+    CHECK(t >= plan.black_from_ns);
+    CHECK(t < plan.black_from_ns + kSec / 5);  // on the first frames without a tracked feature
+    CHECK(e.event.rfind("reset: fewer than 2 features tracked", 0) == 0);
+    ++resets_in_black;
+  }
+  CHECK(resets_in_black == 1);
+  check_reported_and_recovered(run, 7 * kSec);
 }
 
 TEST_CASE("the whole view moving for 2 s: reported, never NaN, no silent jump, recovered", "[vio][faults]") {
@@ -123,38 +193,9 @@ TEST_CASE("the whole view moving for 2 s: reported, never NaN, no silent jump, r
   REQUIRE(run.result.report.ok);
   REQUIRE(run.frames_wall > 30);
   check_reported_and_recovered(run, 9 * kSec);
-  // Through the wall the estimate either stops tracking (and says why, checked above) or does not follow
-  // the wall: every tracking estimate inside it, measured from the last tracking one before it with no
-  // reset between, moved (in that frame's body axes) as the truth did, within 0.5 m (the wall alone says
-  // ~0.8 m/s sideways at its 1.3 m).
-  const auto truth_at = [&](int64_t t_ns) -> const GroundTruthState& {
-    for (const auto& g : run.result.ground_truth)
-      if (g.t_ns >= t_ns) return g;
-    return run.result.ground_truth.back();
-  };
-  const estimator::WindowEstimate* before = nullptr;
-  int tracking_in_wall = 0;
-  int64_t back_ns = -1;  // first tracking estimate after the wall
-  for (const auto& e : run.estimates) {
-    const int64_t t = e.t_ns - run.start_ns;
-    const bool tracking = e.status == estimator::EstimatorStatus::Tracking;
-    if (t < plan.wall_from_ns) {
-      before = tracking ? &e : nullptr;
-      continue;
-    }
-    if (t >= plan.wall_to_ns) {
-      if (tracking && back_ns < 0) back_ns = t - plan.wall_to_ns;
-      continue;
-    }
-    if (!tracking) before = nullptr;  // a reset: nothing to compare with until it tracks again
-    if (!tracking || before == nullptr) continue;
-    ++tracking_in_wall;
-    const GroundTruthState &ga = truth_at(before->t_ns), &gb = truth_at(e.t_ns);
-    const Eigen::Vector3d est = before->state.q_wb.conjugate() * (e.state.p_wb - before->state.p_wb);
-    const Eigen::Vector3d truth = ga.q_wb.conjugate() * (gb.p_wb - ga.p_wb);
-    INFO("t = " << t * 1e-9 << " s in the wall: estimated " << est.transpose() << ", true " << truth.transpose());
-    CHECK((est - truth).norm() < 0.5);
-  }
+  // The wall alone says ~0.8 m/s sideways at its 1.3 m: the estimate must not follow it.
+  int64_t back_ns = -1;
+  const int tracking_in_wall = check_not_misled(run, plan.wall_from_ns, plan.wall_to_ns, &back_ns);
   INFO("tracking estimates inside the wall " << tracking_in_wall << "; tracking again " << back_ns * 1e-9
                                              << " s after it");
   CHECK(back_ns >= 0);
