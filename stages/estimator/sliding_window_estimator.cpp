@@ -426,12 +426,7 @@ std::string SlidingWindowEstimator::Impl::failure_reason(const Eigen::Vector3d& 
   // window through that; a view lost for longer than max_blind_time (black images, a covered lens) resets.
   if (features.last_tracked_count() < 2) {
     const int64_t t = state.t_ns[newest];
-    if (blind_since_ns < 0) {
-      blind_since_ns = t;
-      spdlog::info("t={:.3f}: fewer than 2 features tracked from the previous frame: the IMU carries the estimate "
-                   "(for at most max_blind_time = {} s)",
-                   t * 1e-9, opt.max_blind_time);
-    }
+    if (blind_since_ns < 0) blind_since_ns = t;
     if (t - blind_since_ns >= std::llround(opt.max_blind_time * 1e9))
       return fmt::format("fewer than 2 features tracked for {:.2f} s (max_blind_time)", (t - blind_since_ns) * 1e-9);
   } else {
@@ -664,6 +659,12 @@ WindowEstimate SlidingWindowEstimator::Impl::process(const TrackedFrame& frame, 
     features.remove_bad_depths();
     const std::string why = failure_reason(last_p, last_q);
     if (!why.empty()) return fail(why, -1);
+    if (blind_since_ns == state.t_ns[newest]) {  // the first frame of a blind run: say so (events, LCM status)
+      if (!e.event.empty()) e.event += "; ";
+      e.event += fmt::format("blind: fewer than 2 features tracked from the previous frame, the IMU carries the "
+                             "estimate for up to max_blind_time = {} s",
+                             opt.max_blind_time);
+    }
   }
   spdlog::debug("t={:.3f} p=({:.3f},{:.3f},{:.3f}) v=({:.3f},{:.3f},{:.3f}) ba={:.3f} bg={:.4f} ba_ms={:.1f} it={} alt={} feats={} kf={} still={}",
                 frame.t_ns * 1e-9, state.p(newest).x(), state.p(newest).y(), state.p(newest).z(), state.v(newest).x(),
