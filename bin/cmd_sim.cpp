@@ -78,7 +78,7 @@ void run_sim(const SimOptions& o) {
   eval::Trajectory truth;
   pipeline::Progress progress("sim");
   double moving_sum = 0, moving_max = 0, preview_gap = 2.0;
-  int64_t frames = 0, frames_mostly_moving = 0, t_first = 0, t_last = 0;
+  int64_t frames = 0, frames_mostly_moving = 0;
   std::pair<cv::Mat, cv::Mat> best_preview;
   SensorEvent e;
   while (source.next(e)) {
@@ -91,8 +91,6 @@ void run_sim(const SimOptions& o) {
       moving_sum += moving;
       moving_max = std::max(moving_max, moving);
       if (moving > 0.6) ++frames_mostly_moving;  // the issue-23 yardstick: seconds above 60 %
-      if (frames == 0) t_first = f->t_ns;
-      t_last = f->t_ns;
       if (std::abs(moving - 0.6) < preview_gap) preview_gap = std::abs(moving - 0.6), best_preview = previews(*f);
       ++frames;
       progress.update(source.progress(), fmt::format("{}/{} frames", frames, source.frame_count()));
@@ -109,12 +107,10 @@ void run_sim(const SimOptions& o) {
     fs::remove_all(euroc_dir);
     fs::rename(euroc_dir + ".partial", euroc_dir);
   }
-  const double frame_period =
-      frames > 1 ? static_cast<double>(t_last - t_first) * 1e-9 / static_cast<double>(frames - 1) : 0.0;
   progress.done(
       fmt::format("{} stereo frames, moving pixels {:.1f}% on average, {:.1f}% at most, above 60% for {:.1f} s", frames,
                   100.0 * moving_sum / static_cast<double>(std::max<int64_t>(frames, 1)), 100.0 * moving_max,
-                  static_cast<double>(frames_mostly_moving) * frame_period));
+                  static_cast<double>(frames_mostly_moving) / scenario->frame_rate));
   spdlog::info("wrote {}, {}/groundtruth.tum, {}/preview(_labels).png{}", log_path, o.out, o.out,
                o.euroc ? ", " + euroc_dir + "/ (EuRoC + vins_config.yaml)" : std::string());
 }

@@ -74,15 +74,13 @@ PathProfile profile_of(const ScenarioSpec& s) {
   return p;
 }
 
-}  // namespace
-
-namespace {
 /// cam1 = cam0 moved `baseline` along cam0's x axis.
 void place_cam1(StereoRig& rig) {
   Eigen::Isometry3d T_cam0_cam1 = Eigen::Isometry3d::Identity();
   T_cam0_cam1.translation() = Eigen::Vector3d(rig.baseline, 0, 0);
   rig.T_body_cam1 = rig.T_body_cam0 * T_cam0_cam1;
 }
+
 }  // namespace
 
 StereoRig StereoRig::standard() {
