@@ -119,13 +119,6 @@ struct EstimatorOptions {
   /// moving with the camera looks exactly like it (window_optimizer.cpp, depth_unobservable; README,
   /// "Street scenes"). 30 = a parallax of 1.9 deg.
   double mono_max_depth_baselines = 30.0;
-  /// Ours (dynavins): the weight step's r_j at the track's best-fit 3-D point (bearing and depth) rather
-  /// than at the best depth along the bearing of its first observation, whose error the fixed bearing
-  /// passes on to every later residual (window_optimizer.cpp, feature_residual_with).
-  bool weight_fit_bearing = false;
-  /// Ours (dynavins): the BA holds each track's point on the bearing fitted to all its observations at the
-  /// start of each solve, not on its first corner's (window_optimizer.cpp, fit_anchor_bearings).
-  bool anchor_fit_bearing = false;
   /// Ours (dynavins, mono only; 0 = off): each track keeps its observations in up to this many keyframes
   /// after they leave the window, with their estimated poses; a track that, over those and the window
   /// together, does not fit one static point (r_j beyond λw) stays out of the state step and the prior.

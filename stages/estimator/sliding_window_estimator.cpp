@@ -52,8 +52,6 @@ WindowSolveOptions solve_options(const EstimatorOptions& o, const EstimatorMode&
   s.weights.residual_per_component = o.residual_per_component;
   s.weights.oracle_labels = o.oracle_labels;
   s.mono_max_depth_baselines = o.mono_max_depth_baselines;
-  s.weight_fit_bearing = o.weight_fit_bearing;
-  s.anchor_fit_bearing = o.anchor_fit_bearing;
   return s;
 }
 
@@ -230,7 +228,7 @@ void SlidingWindowEstimator::Impl::pnp_newest() {
   for (const auto& [id, f] : features.all()) {
     if (!f.has_depth || f.start_slot >= newest || f.end_slot() != newest) continue;
     const CameraPose a = state.camera(f.start_slot, 0);
-    const Eigen::Vector3d p_w = a.R * (f.anchor_bearing() / f.inv_depth) + a.p;
+    const Eigen::Vector3d p_w = a.R * (Eigen::Vector3d(f.obs[0].xy.x(), f.obs[0].xy.y(), 1.0) / f.inv_depth) + a.p;
     const Eigen::Vector2d& xy = f.obs.back().xy;
     pts.emplace_back(p_w.x(), p_w.y(), p_w.z());
     obs.emplace_back(xy.x(), xy.y());
@@ -493,7 +491,7 @@ void SlidingWindowEstimator::Impl::fill_output(WindowEstimate& e) {
       wf.u_r = static_cast<float>(f.obs.back().px_right.x());
       wf.v_r = static_cast<float>(f.obs.back().px_right.y());
     }
-    wf.p_w = a.R * (f.anchor_bearing() / f.inv_depth) + a.p;
+    wf.p_w = a.R * (Eigen::Vector3d(f.obs[0].xy.x(), f.obs[0].xy.y(), 1.0) / f.inv_depth) + a.p;
     wf.weight = static_cast<float>(mode.loss == BaLoss::Dynavins ? f.weight : 1.0);
     wf.times_solved = f.times_solved;
     wf.sim_label = f.sim_label;
@@ -520,7 +518,7 @@ Keyframe SlidingWindowEstimator::Impl::make_keyframe(int slot) const {
     p.xy = o.xy;
     if (f.has_depth && f.inv_depth > 0) {
       const CameraPose a = state.camera(f.start_slot, 0);
-      p.p_w = a.R * (f.anchor_bearing() / f.inv_depth) + a.p;
+      p.p_w = a.R * (Eigen::Vector3d(f.obs[0].xy.x(), f.obs[0].xy.y(), 1.0) / f.inv_depth) + a.p;
       p.has_p_w = true;
     }
     p.weight = static_cast<float>(mode.loss == BaLoss::Dynavins ? f.weight : 1.0);

@@ -90,10 +90,8 @@ void WindowFeatures::triangulate(const SlotCameraPose& cam, const Eigen::Isometr
 }
 
 void WindowFeatures::reanchor(WindowFeature& f, const CameraPose& old_anchor, const CameraPose& new_anchor) const {
-  const Eigen::Vector3d bearing = f.anchor_bearing();
-  f.anchor_refined = false;  // the new anchor's own observation, until the next solve fits it
   if (!f.has_depth) return;
-  const Eigen::Vector3d p_c = bearing / f.inv_depth;
+  const Eigen::Vector3d p_c = Eigen::Vector3d(f.obs[0].xy.x(), f.obs[0].xy.y(), 1.0) / f.inv_depth;
   const Eigen::Vector3d p_w = old_anchor.R * p_c + old_anchor.p;
   const double depth = (new_anchor.R.transpose() * (p_w - new_anchor.p)).z();
   if (std::isfinite(depth) && depth > 0.1) {

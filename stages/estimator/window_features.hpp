@@ -56,15 +56,6 @@ struct WindowFeature {
   double weight_prev = 1.0;  ///< w̄_j: weight after the previous window solve
   int times_solved = 0;      ///< n_j
   int8_t sim_label = -1;     ///< simulator label at the latest observation (scoring only)
-  /// With anchor_fit_bearing: the anchor bearing (z = 1 plane) fitted to every observation of the track
-  /// at the start of the latest window solve, which the BA then holds fixed instead of obs[0].xy (a corner
-  /// a pixel off at the anchor would otherwise pull every later residual); cleared when the anchor changes.
-  bool anchor_refined = false;
-  Eigen::Vector2d refined_anchor_xy = Eigen::Vector2d::Zero();
-
-  /// The anchor bearing the BA parametrises the point along (inverse depth `inv_depth` on it).
-  const Eigen::Vector2d& anchor_xy() const { return anchor_refined ? refined_anchor_xy : obs[0].xy; }
-  Eigen::Vector3d anchor_bearing() const { return anchor_xy().homogeneous(); }
 
   int end_slot() const { return start_slot + static_cast<int>(obs.size()) - 1; }
   bool in_ba() const { return has_depth && static_cast<int>(obs.size()) >= kMinObservationsInBa; }

@@ -42,7 +42,7 @@ std::vector<VisualResidual> visual_residuals(WindowState& s, WindowFeature& f, c
   const bool dyn = o.loss == BaLoss::Dynavins;
   const double* w = dyn ? &f.state_weight : nullptr;  // ŵ_j (feature_weights.hpp)
   const int i = f.start_slot;
-  const Eigen::Vector2d& xy_i = f.anchor_xy();
+  const Eigen::Vector2d& xy_i = f.obs[0].xy;
   double* pose_i = s.pose[i].data();
   double* ex0 = s.extrinsic[0].data();
   double* ex1 = s.extrinsic[1].data();
@@ -115,15 +115,13 @@ struct FeatureGeometry {
   std::vector<Obs> obs;
   double sqrt_info = 1;
   double inverse_depth = 0;  ///< the best fit of the last feature_residual_with()
-  bool free_bearing = false;  ///< the fit moves `bearing` too (key weight_fit_bearing)
 
-  Eigen::Vector2d residual(const Obs& o, const Eigen::Vector3d& b, double rho) const {
-    const Eigen::Vector3d p_w = anchor.R * (b / rho) + anchor.p;
+  Eigen::Vector2d residual(const Obs& o, double rho) const {
+    const Eigen::Vector3d p_w = anchor.R * (bearing / rho) + anchor.p;
     const Eigen::Vector3d p_c = o.cam.R.transpose() * (p_w - o.cam.p);
     if (p_c.z() <= 1e-3) return Eigen::Vector2d(1e2, 1e2);  // behind the camera: as bad as it gets
     return sqrt_info * (p_c.head<2>() / p_c.z() - o.xy);
   }
-  Eigen::Vector2d residual(const Obs& o, double rho) const { return residual(o, bearing, rho); }
   /// r_j of feature_weights.hpp over the weighted observations (feature_residual_scale).
   double weighted_mean(double rho, const FeatureWeightParams& p) const {
     std::vector<double> sq;
@@ -131,38 +129,21 @@ struct FeatureGeometry {
       if (o.weighted) sq.push_back(residual(o, rho).squaredNorm());
     return feature_residual_scale(sq, p);
   }
-  /// Inverse depth that best explains every observation with the poses fixed (Gauss-Newton from `rho`);
-  /// with free_bearing the bearing is fitted as well (a 3-D point), and `bearing` holds the result.
-  double best_inverse_depth(double rho) {
-    const int n = free_bearing ? 3 : 1;  // parameters (rho[, bearing x, bearing y])
+  /// Inverse depth that best explains every observation with the poses fixed (1-D Gauss-Newton).
+  double best_inverse_depth(double rho) const {
     for (int it = 0; it < 5; ++it) {
-      const double h[3] = {1e-6 * std::max(rho, 1e-3), 1e-7, 1e-7};
-      Eigen::Matrix3d H = Eigen::Matrix3d::Zero();
-      Eigen::Vector3d b = Eigen::Vector3d::Zero();
+      const double h = 1e-6 * std::max(rho, 1e-3);
+      double H = 0, b = 0;
       for (const Obs& o : obs) {
-        const Eigen::Vector2d e = residual(o, bearing, rho);
-        Eigen::Matrix<double, 2, 3> J = Eigen::Matrix<double, 2, 3>::Zero();
-        J.col(0) = (residual(o, bearing, rho + h[0]) - e) / h[0];
-        for (int k = 1; k < n; ++k) {
-          Eigen::Vector3d bk = bearing;
-          bk[k - 1] += h[k];
-          J.col(k) = (residual(o, bk, rho) - e) / h[k];
-        }
-        H += J.transpose() * J;
-        b += J.transpose() * e;
+        const Eigen::Vector2d e = residual(o, rho);
+        const Eigen::Vector2d J = (residual(o, rho + h) - e) / h;
+        H += J.squaredNorm();
+        b += J.dot(e);
       }
-      if (!(H(0, 0) > 0)) break;
-      Eigen::Vector3d step = Eigen::Vector3d::Zero();
-      if (n == 1) {
-        step[0] = -b[0] / H(0, 0);
-      } else {
-        H.diagonal() *= 1.0 + 1e-9;  // keeps an ill-posed track (no parallax) solvable
-        step = -H.ldlt().solve(b);
-        if (!step.allFinite()) break;
-        bearing.head<2>() += step.tail<2>();
-      }
-      rho = std::clamp(rho + step[0], 1e-3, 10.0);  // depth between 0.1 m and 1 km
-      if (std::abs(step[0]) < 1e-6 && step.tail<2>().norm() < 1e-8) break;
+      if (!(H > 0)) break;
+      const double step = -b / H;
+      rho = std::clamp(rho + step, 1e-3, 10.0);  // depth between 0.1 m and 1 km
+      if (std::abs(step) < 1e-6) break;
     }
     return rho;
   }
@@ -185,17 +166,13 @@ double feature_residual_with(const WindowFeature& f, const WindowSolveOptions& o
   // only "is this track consistent with a static point under the estimated motion?". The stereo
   // observations of every frame stay in that fit, so an object moving with the camera (which a point at
   // infinity would explain without them) still does not fit.
-  // With weight_fit_bearing the point's bearing is fitted too, and the anchor's own observation is one
-  // residual among the others: a track whose first corner sits a pixel off otherwise carries that pixel
-  // in every later residual (twice the noise of the track's other observations, all of it counted in r_j).
   g.anchor = camera(f.start_slot, 0);
-  g.bearing = f.obs[0].xy.homogeneous();  // its own corner, whatever bearing the BA holds (anchor_fit_bearing)
+  g.bearing = Eigen::Vector3d(f.obs[0].xy.x(), f.obs[0].xy.y(), 1.0);
   g.sqrt_info = opt.sqrt_info;
-  g.free_bearing = opt.weight_fit_bearing;
   g.obs.clear();
   for (size_t k = 0; k < f.obs.size(); ++k) {
     const int j = f.start_slot + static_cast<int>(k);
-    if (k > 0 || g.free_bearing) g.obs.push_back({camera(j, 0), f.obs[k].xy, true});
+    if (k > 0) g.obs.push_back({camera(j, 0), f.obs[k].xy, true});
     if (opt.stereo && f.obs[k].has_right) g.obs.push_back({camera(j, 1), f.obs[k].xy_right, k > 0});
   }
   g.inverse_depth = g.best_inverse_depth(f.inv_depth);
@@ -259,27 +236,6 @@ double WindowOptimizer::feature_residual(const WindowState& s, const WindowFeatu
   FeatureGeometry g;
   return feature_residual_with(f, opt_, [&s](int k, int c) { return s.camera(k, c); }, g);
 }
-
-namespace {
-
-/// anchor_fit_bearing: the BA holds each track's point on the bearing and at the depth that best explain
-/// all its observations at the states the solve starts from (the anchor's own corner a residual like the
-/// others), instead of on the bearing of the anchor's corner, whose error would reach every residual.
-void fit_anchor_bearings(const WindowState& s, int newest, WindowFeatures& features, WindowSolveOptions opt) {
-  opt.weight_fit_bearing = true;  // the 3-D point fit of feature_residual_with
-  FeatureGeometry g;
-  const auto camera = [&s](int k, int c) { return s.camera(k, c); };
-  for (auto& [id, f] : features.all()) {
-    if (!f.in_ba() || f.start_slot > newest) continue;
-    feature_residual_with(f, opt, camera, g);
-    if (!g.bearing.allFinite() || !(g.inverse_depth > 0)) continue;
-    f.refined_anchor_xy = g.bearing.head<2>();
-    f.anchor_refined = true;
-    f.inv_depth = g.inverse_depth;
-  }
-}
-
-}  // namespace
 
 namespace {
 
@@ -506,7 +462,6 @@ SolveStats WindowOptimizer::solve(WindowState& s, int newest, WindowFeatures& fe
   SolveStats st;
   const auto t_ba = Clock::now();
   const WindowGauge gauge = WindowGauge::of(s);
-  if (opt_.loss == BaLoss::Dynavins && opt_.anchor_fit_bearing) fit_anchor_bearings(s, newest, features, opt_);
   WindowProblem window(s, newest, features, opt_, prior_, prior_blocks_);
   st.features_in_window = static_cast<int>(window.features().size());
   StateSolver solver(window.problem(), opt_, st);

@@ -44,13 +44,6 @@ struct WindowSolveOptions {
   /// under 1/K rad), while the median depth of the features in use is within that reach, stays out of the
   /// state step and the prior (ŵ_j = 0; key mono_max_depth_baselines; window_optimizer.cpp).
   double mono_max_depth_baselines = 30.0;
-  /// Ours (dynavins): r_j of the weight step is measured at the 3-D point that best explains the track
-  /// (bearing and depth fitted, the anchor's observation a residual like the others) instead of at the
-  /// best depth along the anchor's observed bearing (key weight_fit_bearing; window_optimizer.cpp).
-  bool weight_fit_bearing = false;
-  /// Ours (dynavins): before each solve the BA's point of each track is put on the bearing and at the
-  /// depth that best explain all its observations (key anchor_fit_bearing; window_optimizer.cpp).
-  bool anchor_fit_bearing = false;
 };
 
 class WindowOptimizer {

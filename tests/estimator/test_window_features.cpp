@@ -107,35 +107,6 @@ TEST_CASE("stereo depths, slot shifts and re-anchoring keep every feature on its
   }
 }
 
-TEST_CASE("re-anchoring carries a fitted anchor bearing's point and returns to the new anchor's corner",
-          "[window_features]") {
-  // anchor_fit_bearing (window_optimizer.cpp) holds a track's point on a fitted bearing; when its anchor
-  // leaves the window the depth moves with that point, and the new anchor starts from its own corner.
-  const Scene s = make_scene(10);
-  Eigen::Isometry3d T_c0c1 = Eigen::Isometry3d::Identity();
-  T_c0c1.translation() = Eigen::Vector3d(0.11, 0, 0);
-  WindowFeatures wf;
-  std::vector<CameraPose> cams;
-  for (int k = 0; k < 3; ++k) {
-    cams.push_back(s.camera(k));
-    wf.add_frame(k, s.frame(k, 0, 10, T_c0c1), 10.0 / kNominalFocalPx, true);
-  }
-  SlotCameraPose cam = [&](int k) { return cams[k]; };
-  wf.triangulate(cam, T_c0c1, true);
-  WindowFeature& f = wf.all().at(4);
-  CHECK(f.anchor_xy() == f.obs[0].xy);  // no fit yet: the corner itself
-  f.refined_anchor_xy = f.obs[0].xy + Eigen::Vector2d(0.004, -0.003);
-  f.anchor_refined = true;
-  f.inv_depth *= 1.05;
-  CHECK(f.anchor_xy() == f.refined_anchor_xy);
-  const Eigen::Vector3d fitted_point = cams[0].R * (f.anchor_bearing() / f.inv_depth) + cams[0].p;
-  wf.remove_oldest(cam);
-  const WindowFeature& g = wf.all().at(4);
-  CHECK_FALSE(g.anchor_refined);
-  CHECK(g.anchor_xy() == g.obs[0].xy);
-  CHECK(1.0 / g.inv_depth == Approx((cams[1].R.transpose() * (fitted_point - cams[1].p)).z()).epsilon(1e-9));
-}
-
 TEST_CASE("the oldest slot's observations join the tracks' past with its pose, the latest max_past kept",
           "[window_features]") {
   const Scene s = make_scene(30);
