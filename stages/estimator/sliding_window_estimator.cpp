@@ -100,6 +100,7 @@ struct SlidingWindowEstimator::Impl {
   void clear_window();
   void place_frame(const TrackedFrame& frame);
   void pnp_newest();
+  void note_blind_run();
   std::string failure_reason(const Eigen::Vector3d& last_p, const Eigen::Quaterniond& last_q);
   void slide(bool keep_second_newest);
   bool imu_agrees_still();
@@ -419,18 +420,24 @@ void SlidingWindowEstimator::Impl::apply_mono_init(const MonoInitResult& r) {
   }
 }
 
+/// Starts or ends the run of frames tracking fewer than 2 features from the previous frame (blind_since_ns).
+void SlidingWindowEstimator::Impl::note_blind_run() {
+  if (features.last_tracked_count() >= 2) {
+    blind_since_ns = -1;
+  } else if (blind_since_ns < 0) {
+    blind_since_ns = state.t_ns[newest];
+  }
+}
+
 std::string SlidingWindowEstimator::Impl::failure_reason(const Eigen::Vector3d& last_p,
                                                         const Eigen::Quaterniond& last_q) {
   // VINS-Fusion's failureDetection thresholds, but for the "little feature" one: VINS-Fusion only logs it and
   // goes on. A truck crossing close in front hides every static corner for a moment, and the IMU carries the
   // window through that; a view lost for longer than max_blind_time (black images, a covered lens) resets.
-  if (features.last_tracked_count() < 2) {
-    const int64_t t = state.t_ns[newest];
-    if (blind_since_ns < 0) blind_since_ns = t;
-    if (t - blind_since_ns >= std::llround(opt.max_blind_time * 1e9))
-      return fmt::format("fewer than 2 features tracked for {:.2f} s (max_blind_time)", (t - blind_since_ns) * 1e-9);
-  } else {
-    blind_since_ns = -1;
+  if (blind_since_ns >= 0) {
+    const int64_t blind_ns = state.t_ns[newest] - blind_since_ns;
+    if (blind_ns >= std::llround(opt.max_blind_time * 1e9))
+      return fmt::format("fewer than 2 features tracked for {:.2f} s (max_blind_time)", blind_ns * 1e-9);
   }
   if (state.ba(newest).norm() > 2.5) return "accelerometer bias estimate above 2.5 m/s^2";
   if (state.bg(newest).norm() > 1.0) return "gyroscope bias estimate above 1 rad/s";
@@ -657,6 +664,7 @@ WindowEstimate SlidingWindowEstimator::Impl::process(const TrackedFrame& frame, 
                        imu_still.ba(), imu_still.bg());
     }
     features.remove_bad_depths();
+    note_blind_run();
     const std::string why = failure_reason(last_p, last_q);
     if (!why.empty()) return fail(why, -1);
     if (blind_since_ns == state.t_ns[newest]) {  // the first frame of a blind run: say so (events, LCM status)
